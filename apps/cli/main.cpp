@@ -1,0 +1,52 @@
+// nipdem: one executable, subcommands registered by the cmd_*.cpp files (see registry.hpp).
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/version.hpp"
+#include "registry.hpp"
+
+namespace nipdem::cli {
+
+std::vector<Registrar>& registry() {
+  static std::vector<Registrar> r;
+  return r;
+}
+
+CLI::App* group(CLI::App& app, const std::string& name, const std::string& description) {
+  for (CLI::App* s : app.get_subcommands([](CLI::App*) { return true; })) {
+    if (s->get_name() == name) return s;
+  }
+  CLI::App* g = app.add_subcommand(name, description);
+  g->require_subcommand(1);
+  return g;
+}
+
+void print_json(const std::string& json) {
+  std::fwrite(json.data(), 1, json.size(), stdout);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+}  // namespace nipdem::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"nipdem: discrete element simulation of toner in the development nip of a DI printer"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("nipdem ") + nipdem::kVersion + " (" + nipdem::kGitHash + ")");
+  for (auto& reg : nipdem::cli::registry()) reg(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;  // CLI.md: bad usage exits 2
+  } catch (const nipdem::InputError& e) {
+    std::cerr << "nipdem: error: " << e.what() << '\n';
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "nipdem: failure: " << e.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,33 @@
+// Subcommand registry: each cmd_*.cpp registers a function that adds its subcommand(s) to
+// the CLI11 app, so adding a command never touches main.cpp.
+//
+//   static nipdem::cli::Register reg([](CLI::App& app) {
+//     auto* force = nipdem::cli::group(app, "force", "Evaluate single force laws");
+//     auto* sub = force->add_subcommand("electric", "...");
+//     ...; sub->callback([=] { ... });
+//   });
+//
+// Callbacks report bad input by throwing nipdem::InputError (exit 2); anything else exits 1.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace nipdem::cli {
+
+using Registrar = std::function<void(CLI::App&)>;
+std::vector<Registrar>& registry();
+
+struct Register {
+  explicit Register(Registrar r) { registry().push_back(std::move(r)); }
+};
+
+// Returns the subcommand `name` of `app`, creating it (with `description`) if absent.
+// Lets several files add children to one group such as "force" or "experiment".
+CLI::App* group(CLI::App& app, const std::string& name, const std::string& description);
+
+// Prints one JSON document (already serialised) on stdout followed by a newline.
+void print_json(const std::string& json);
+
+}  // namespace nipdem::cli
