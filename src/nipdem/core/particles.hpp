@@ -1,0 +1,46 @@
+// Structure-of-arrays storage of rigid bodies (clusters) and the discs they are made of
+// (thesis §2.1: a toner particle is n kinematically clustered spheres). The discs of a body
+// are contiguous, so removing a body removes one index range. The engine's hot loops read
+// these arrays directly; nothing here knows about toner.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+namespace nipdem {
+
+struct BodyStore {
+  // Kinematics of the centre of mass [m, m/s, rad, rad/s].
+  std::vector<double> x, y, vx, vy, theta, omega;
+  // Total force [N] and torque about the centre of mass [N m] from the last force evaluation.
+  std::vector<double> fx, fy, torque;
+  std::vector<double> mass, inertia;     // [kg], [kg m^2] about the centre of mass (z axis)
+  std::vector<std::int64_t> id;          // stable identity (never reused within a run)
+  std::vector<int> first_disc, n_discs;  // discs [first_disc, first_disc + n_discs)
+  std::vector<int> tag;                  // user tag (e.g. cluster template index)
+  std::vector<double> size;              // user size measure (e.g. volume-equivalent diameter) [m]
+
+  std::size_t size_n() const { return x.size(); }
+};
+
+// Wall contact history slots per disc: enough for a disc touching a drum, a roller face
+// and the two faces of a pit at once.
+inline constexpr int kWallSlots = 4;
+
+struct DiscStore {
+  std::vector<double> x, y;    // world position of the disc centre [m]
+  std::vector<double> ox, oy;  // offset from the body's centre of mass in the body frame [m]
+  std::vector<double> r;       // radius [m]
+  std::vector<int> body;       // owning body index
+  std::vector<double> wx, wy;  // current world-frame offset from the body centre of mass [m]
+  // Force [N] and torque about the disc centre [N m] accumulated in one evaluation.
+  std::vector<double> fx, fy, tq;
+  std::vector<double> fax, fay;  // adhesive part of (fx, fy), kept for output [N]
+  // Wall contact history: key (-1 = empty), tangential stretch, sliding flag.
+  std::vector<std::int64_t> wall_key;    // kWallSlots per disc
+  std::vector<double> wall_eta;          // kWallSlots per disc
+  std::vector<std::uint8_t> wall_slide;  // kWallSlots per disc
+
+  std::size_t size_n() const { return x.size(); }
+};
+
+}  // namespace nipdem

@@ -1,0 +1,579 @@
+#include "nipdem/engine/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <limits>
+#include <ostream>
+#include <stdexcept>
+
+#include <omp.h>
+
+#include "nipdem/core/constants.hpp"
+#include "nipdem/core/error.hpp"
+
+namespace nipdem::engine {
+
+using models::ContactParams;
+using models::TangentialState;
+
+Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
+    : params_(std::move(params)), walls_(std::move(walls)) {
+  if (params_.interactions.empty()) throw_input("engine", "interactions", "", "at least the disc-disc interaction is required");
+  require_positive("engine", "dt_s", params_.dt);
+  require_positive("engine", "skin_m", params_.skin);
+  if (params_.threads < 1) throw_input("engine", "threads", std::to_string(params_.threads), "must be >= 1");
+  if (params_.periodic_x && !(params_.x_hi > params_.x_lo))
+    throw_input("engine", "periodic_x", "", "x_hi must exceed x_lo for a periodic box");
+  for (auto& w : walls_) {
+    w.validate();
+    if (w.interaction < 0 || w.interaction >= static_cast<int>(params_.interactions.size()))
+      throw_input("wall '" + w.name + "'", "interaction", std::to_string(w.interaction), "no such interaction");
+  }
+  const auto& ad = params_.interactions[0].adhesion;
+  pair_reach_ = ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0;
+  nl_params_.skin = params_.skin;
+  nl_params_.extra_range = pair_reach_;
+  nl_params_.periodic_x = params_.periodic_x;
+  nl_params_.x_lo = params_.x_lo;
+  nl_params_.x_hi = params_.x_hi;
+}
+
+int Simulation::add_body(const BodySpec& s) {
+  const std::size_t n = s.offsets.size();
+  if (n == 0 || s.radii.size() != n) throw_input("body", "discs", std::to_string(n), "need >= 1 disc with one radius each");
+  require_positive("body", "density_kg_per_m3", s.density);
+  double m = 0.0;
+  Vec2 com{};
+  std::vector<double> mk(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    require_positive("body", "radius_m", s.radii[k]);
+    const double r = s.radii[k];
+    mk[k] = s.density * 4.0 / 3.0 * constants::pi * r * r * r;  // each member a solid sphere (§2.1)
+    m += mk[k];
+    com += mk[k] * s.offsets[k];
+  }
+  com /= m;
+  double inertia = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = s.radii[k];
+    const double own = s.sphere_inertia ? 0.4 * mk[k] * r * r : 0.5 * mk[k] * r * r;
+    inertia += own + mk[k] * norm2(s.offsets[k] - com);  // parallel-axis theorem
+  }
+  const int bi = static_cast<int>(b_.x.size());
+  b_.x.push_back(s.position.x); b_.y.push_back(s.position.y);
+  b_.vx.push_back(s.velocity.x); b_.vy.push_back(s.velocity.y);
+  b_.theta.push_back(s.angle); b_.omega.push_back(s.omega);
+  b_.fx.push_back(0.0); b_.fy.push_back(0.0); b_.torque.push_back(0.0);
+  b_.mass.push_back(m); b_.inertia.push_back(inertia);
+  b_.id.push_back(next_id_++);
+  b_.first_disc.push_back(static_cast<int>(d_.x.size()));
+  b_.n_discs.push_back(static_cast<int>(n));
+  b_.tag.push_back(s.tag);
+  b_.size.push_back(s.size);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Vec2 o = s.offsets[k] - com;
+    d_.ox.push_back(o.x); d_.oy.push_back(o.y);
+    d_.r.push_back(s.radii[k]);
+    d_.body.push_back(bi);
+    d_.x.push_back(0.0); d_.y.push_back(0.0); d_.wx.push_back(0.0); d_.wy.push_back(0.0);
+    d_.fx.push_back(0.0); d_.fy.push_back(0.0); d_.tq.push_back(0.0);
+    d_.fax.push_back(0.0); d_.fay.push_back(0.0);
+    for (int q = 0; q < kWallSlots; ++q) { d_.wall_key.push_back(-1); d_.wall_eta.push_back(0.0); d_.wall_slide.push_back(0); }
+    old_of_new_.push_back(-1);
+  }
+  update_disc_positions(bi, bi + 1);
+  for (auto& v : prov_fx_) v.push_back(0.0);
+  for (auto& v : prov_fy_) v.push_back(0.0);
+  for (auto& v : prov_tq_) v.push_back(0.0);
+  structure_changed_ = true;
+  forces_valid_ = false;
+  return bi;
+}
+
+std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
+  const std::size_t nb = b_.x.size();
+  std::vector<char> drop(nb, 0);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < nb; ++i) if (pred(static_cast<int>(i))) { drop[i] = 1; ++count; }
+  if (count == 0) return 0;
+  // Compact bodies and discs in order (keeps the relative order: the mapping is monotone).
+  std::size_t bw = 0, dw = 0;
+  std::vector<int> new_old_of_new;
+  new_old_of_new.reserve(d_.x.size());
+  auto move_body = [&](std::size_t from, std::size_t to) {
+    b_.x[to] = b_.x[from]; b_.y[to] = b_.y[from]; b_.vx[to] = b_.vx[from]; b_.vy[to] = b_.vy[from];
+    b_.theta[to] = b_.theta[from]; b_.omega[to] = b_.omega[from];
+    b_.fx[to] = b_.fx[from]; b_.fy[to] = b_.fy[from]; b_.torque[to] = b_.torque[from];
+    b_.mass[to] = b_.mass[from]; b_.inertia[to] = b_.inertia[from]; b_.id[to] = b_.id[from];
+    b_.n_discs[to] = b_.n_discs[from]; b_.tag[to] = b_.tag[from]; b_.size[to] = b_.size[from];
+    for (std::size_t k = 0; k < prov_fx_.size(); ++k) {
+      prov_fx_[k][to] = prov_fx_[k][from]; prov_fy_[k][to] = prov_fy_[k][from]; prov_tq_[k][to] = prov_tq_[k][from];
+    }
+  };
+  auto move_disc = [&](std::size_t from, std::size_t to, int body) {
+    d_.x[to] = d_.x[from]; d_.y[to] = d_.y[from]; d_.ox[to] = d_.ox[from]; d_.oy[to] = d_.oy[from];
+    d_.wx[to] = d_.wx[from]; d_.wy[to] = d_.wy[from];
+    d_.r[to] = d_.r[from]; d_.body[to] = body;
+    d_.fx[to] = d_.fx[from]; d_.fy[to] = d_.fy[from]; d_.tq[to] = d_.tq[from];
+    d_.fax[to] = d_.fax[from]; d_.fay[to] = d_.fay[from];
+    for (int q = 0; q < kWallSlots; ++q) {
+      d_.wall_key[to * kWallSlots + q] = d_.wall_key[from * kWallSlots + q];
+      d_.wall_eta[to * kWallSlots + q] = d_.wall_eta[from * kWallSlots + q];
+      d_.wall_slide[to * kWallSlots + q] = d_.wall_slide[from * kWallSlots + q];
+    }
+  };
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (drop[i]) continue;
+    const int first = b_.first_disc[i], nd = b_.n_discs[i];
+    move_body(i, bw);
+    b_.first_disc[bw] = static_cast<int>(dw);
+    for (int k = 0; k < nd; ++k) {
+      move_disc(first + k, dw, static_cast<int>(bw));
+      new_old_of_new.push_back(old_of_new_[first + k]);
+      ++dw;
+    }
+    ++bw;
+  }
+  auto shrink = [](auto& v, std::size_t n) { v.resize(n); };
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
+                  &b_.inertia, &b_.size}) shrink(*v, bw);
+  shrink(b_.id, bw); shrink(b_.first_disc, bw); shrink(b_.n_discs, bw); shrink(b_.tag, bw);
+  for (auto& v : prov_fx_) v.resize(bw);
+  for (auto& v : prov_fy_) v.resize(bw);
+  for (auto& v : prov_tq_) v.resize(bw);
+  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
+    shrink(*v, dw);
+  shrink(d_.body, dw);
+  shrink(d_.wall_key, dw * kWallSlots); shrink(d_.wall_eta, dw * kWallSlots); shrink(d_.wall_slide, dw * kWallSlots);
+  old_of_new_.swap(new_old_of_new);
+  structure_changed_ = true;
+  forces_valid_ = false;
+  return count;
+}
+
+void Simulation::add_force(std::shared_ptr<BodyForce> f) {
+  forces_.push_back(std::move(f));
+  prov_fx_.emplace_back(b_.x.size(), 0.0);
+  prov_fy_.emplace_back(b_.x.size(), 0.0);
+  prov_tq_.emplace_back(b_.x.size(), 0.0);
+  forces_valid_ = false;
+}
+
+void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
+  for (std::size_t b = b0; b < b1; ++b) {
+    const int first = b_.first_disc[b], nd = b_.n_discs[b];
+    const double X = b_.x[b], Y = b_.y[b];
+    if (nd == 1 && d_.ox[first] == 0.0 && d_.oy[first] == 0.0) {
+      d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
+      continue;
+    }
+    const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
+    for (int k = first; k < first + nd; ++k) {
+      const double wx = c * d_.ox[k] - s * d_.oy[k];
+      const double wy = s * d_.ox[k] + c * d_.oy[k];
+      d_.wx[k] = wx; d_.wy[k] = wy;
+      d_.x[k] = X + wx; d_.y[k] = Y + wy;
+    }
+  }
+}
+
+void Simulation::ensure_neighbor_list() {
+  if (structure_changed_) {
+    nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
+  } else if (nlist_.needs_rebuild(d_.x, d_.y)) {
+    nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
+  } else {
+    return;
+  }
+  structure_changed_ = false;
+  for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
+}
+
+template <bool kAdhesion>
+void Simulation::pair_rows(int i0, int i1, double* fx, double* fy, double* tq, double* fax, double* fay,
+                           std::int64_t& nc) {
+  const ContactParams& cp = params_.interactions[0].contact;
+  const models::HamakerParams& hp = params_.interactions[0].adhesion;
+  const double dt = params_.dt;
+  const bool periodic = params_.periodic_x;
+  const double L = params_.x_hi - params_.x_lo;
+  const double reach = pair_reach_;
+  const double* X = d_.x.data(); const double* Y = d_.y.data(); const double* R = d_.r.data();
+  const double* WX = d_.wx.data(); const double* WY = d_.wy.data();
+  const int* B = d_.body.data();
+  const double* VX = b_.vx.data(); const double* VY = b_.vy.data(); const double* W = b_.omega.data();
+  const double* M = b_.mass.data();
+  const int* rs = nlist_.row_start_.data();
+  const int* nb = nlist_.nbr_.data();
+  double* eta = nlist_.eta_.data();
+  std::uint8_t* sl = nlist_.slide_.data();
+  for (int i = i0; i < i1; ++i) {
+    const double xi = X[i], yi = Y[i], ri = R[i];
+    const int bi = B[i];
+    double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
+    for (int e = rs[i]; e < rs[i + 1]; ++e) {
+      const int j = nb[e];
+      double dx = xi - X[j];
+      const double dy = yi - Y[j];
+      if (periodic) dx -= L * std::nearbyint(dx / L);
+      const double rsum = ri + R[j];
+      const double d2 = dx * dx + dy * dy;
+      const double rc = rsum + reach;
+      if (d2 >= rc * rc) {
+        eta[e] = 0.0; sl[e] = 0;
+        continue;
+      }
+      const double dist = std::sqrt(d2);
+      const double inv = 1.0 / dist;
+      const double nx = dx * inv, ny = dy * inv;  // from j to i
+      const double overlap = rsum - dist;
+      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
+      double fa = 0.0;
+      if constexpr (kAdhesion) fa = models::hamaker_force(hp, ri, R[j], -overlap);
+      if (overlap > 0.0) {
+        ++nc;
+        const int bj = B[j];
+        const double li = ri - 0.5 * overlap, lj = R[j] - 0.5 * overlap;
+        // lever arms from the body centres of mass to the contact point
+        const double rix = WX[i] - li * nx, riy = WY[i] - li * ny;
+        const double rjx = WX[j] + lj * nx, rjy = WY[j] + lj * ny;
+        const double vrx = (VX[bi] - W[bi] * riy) - (VX[bj] - W[bj] * rjy);
+        const double vry = (VY[bi] + W[bi] * rix) - (VY[bj] + W[bj] * rjx);
+        const double vn = vrx * nx + vry * ny;
+        const double vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
+        const double mi = M[bi], mj = M[bj];
+        const double mred = mi * mj / (mi + mj);
+        const double fn = models::normal_force(cp, overlap, vn, mred);
+        TangentialState st{eta[e], sl[e] != 0};
+        const double ft = models::tangential_force(cp, st, vt, fn, dt, mred);
+        eta[e] = st.eta; sl[e] = st.sliding;
+        fnx = fn * nx - ft * ny;
+        fny = fn * ny + ft * nx;
+        ti = -li * ft;
+        tj = -lj * ft;
+      } else {
+        eta[e] = 0.0; sl[e] = 0;
+      }
+      if constexpr (kAdhesion) {
+        fnx -= fa * nx; fny -= fa * ny;
+        faxi -= fa * nx; fayi -= fa * ny;
+        fax[j] += fa * nx; fay[j] += fa * ny;
+      }
+      fxi += fnx; fyi += fny; tqi += ti;
+      fx[j] -= fnx; fy[j] -= fny; tq[j] += tj;
+    }
+    fx[i] += fxi; fy[i] += fyi; tq[i] += tqi;
+    if constexpr (kAdhesion) { fax[i] += faxi; fay[i] += fayi; }
+  }
+}
+
+void Simulation::pair_forces() {
+  const std::size_t n = d_.x.size();
+  const int nt = params_.threads;
+  const bool adh = params_.interactions[0].adhesion.hamaker_J != 0.0;
+  if (static_cast<int>(tbuf_.size()) != nt) tbuf_.assign(nt, {});
+  std::int64_t total_nc = 0;
+  if (nt == 1) {
+    std::fill(d_.fx.begin(), d_.fx.end(), 0.0); std::fill(d_.fy.begin(), d_.fy.end(), 0.0);
+    std::fill(d_.tq.begin(), d_.tq.end(), 0.0);
+    std::fill(d_.fax.begin(), d_.fax.end(), 0.0); std::fill(d_.fay.begin(), d_.fay.end(), 0.0);
+    if (adh) pair_rows<true>(0, static_cast<int>(n), d_.fx.data(), d_.fy.data(), d_.tq.data(), d_.fax.data(), d_.fay.data(), total_nc);
+    else pair_rows<false>(0, static_cast<int>(n), d_.fx.data(), d_.fy.data(), d_.tq.data(), d_.fax.data(), d_.fay.data(), total_nc);
+    n_contacts_ = total_nc;
+    return;
+  }
+  // Split rows so each thread gets about the same number of list entries.
+  std::vector<int> split(nt + 1, 0);
+  const auto& rs = nlist_.row_start_;
+  const double per = static_cast<double>(nlist_.pair_count()) / nt;
+  for (int t = 1; t < nt; ++t) {
+    const int target = static_cast<int>(per * t);
+    split[t] = static_cast<int>(std::lower_bound(rs.begin(), rs.end(), target) - rs.begin());
+    split[t] = std::clamp(split[t], split[t - 1], static_cast<int>(n));
+  }
+  split[nt] = static_cast<int>(n);
+  std::vector<std::int64_t> ncs(nt, 0);
+#pragma omp parallel num_threads(nt)
+  {
+    const int t = omp_get_thread_num();
+    auto& buf = tbuf_[t];
+    buf.assign(5 * n, 0.0);
+    double* fx = buf.data(); double* fy = fx + n; double* tq = fy + n; double* fax = tq + n; double* fay = fax + n;
+    if (adh) pair_rows<true>(split[t], split[t + 1], fx, fy, tq, fax, fay, ncs[t]);
+    else pair_rows<false>(split[t], split[t + 1], fx, fy, tq, fax, fay, ncs[t]);
+#pragma omp barrier
+    // Reduce in fixed thread order, each thread over its own slice of discs.
+    const std::size_t lo = n * t / nt, hi = n * (t + 1) / nt;
+    for (std::size_t i = lo; i < hi; ++i) {
+      double a = 0, b = 0, c = 0, p = 0, q = 0;
+      for (int u = 0; u < nt; ++u) {
+        const double* bu = tbuf_[u].data();
+        a += bu[i]; b += bu[n + i]; c += bu[2 * n + i]; p += bu[3 * n + i]; q += bu[4 * n + i];
+      }
+      d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
+    }
+  }
+  for (auto c : ncs) total_nc += c;
+  n_contacts_ = total_nc;
+}
+
+void Simulation::wall_forces() {
+  if (walls_.empty()) return;
+  const std::size_t n = d_.x.size();
+  const double dt = params_.dt;
+  std::int64_t nc_total = 0;
+#pragma omp parallel num_threads(params_.threads) reduction(+ : nc_total)
+  {
+    std::vector<geometry::WallHit> hits;
+    hits.reserve(16);
+    std::int64_t new_key[kWallSlots];
+    double new_eta[kWallSlots];
+    std::uint8_t new_sl[kWallSlots];
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2 c{d_.x[i], d_.y[i]};
+      const double r = d_.r[i];
+      const int bi = d_.body[i];
+      int nnew = 0;
+      double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
+      for (std::size_t w = 0; w < walls_.size(); ++w) {
+        const auto& wall = walls_[w];
+        const Interaction& ia = params_.interactions[wall.interaction];
+        const double reach = ia.adhesion.hamaker_J != 0.0 ? ia.adhesion.cutoff_m : 0.0;
+        hits.clear();
+        wall.query(c, r, reach, hits);
+        for (const auto& h : hits) {
+          double fnx = 0, fny = 0;
+          const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
+          if (h.gap < 0.0) {
+            ++nc_total;
+            const double overlap = -h.gap;
+            const double l = r - 0.5 * overlap;
+            const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
+            const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
+            const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
+            const double vn = vrx * h.normal.x + vry * h.normal.y;
+            const double vt = -vrx * h.normal.y + vry * h.normal.x;
+            const double m = b_.mass[bi];
+            const double fn = models::normal_force(ia.contact, overlap, vn, m);
+            const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+            TangentialState st{};
+            for (int q = 0; q < kWallSlots; ++q) {
+              if (d_.wall_key[i * kWallSlots + q] == key) {
+                st.eta = d_.wall_eta[i * kWallSlots + q];
+                st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
+                break;
+              }
+            }
+            const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
+            if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
+              new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
+            }
+            fnx = fn * h.normal.x - ft * h.normal.y;
+            fny = fn * h.normal.y + ft * h.normal.x;
+            tq += -l * ft;
+          }
+          fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
+          fax -= fa * h.normal.x; fay -= fa * h.normal.y;
+          fx += fnx; fy += fny;
+        }
+      }
+      for (int q = 0; q < kWallSlots; ++q) {
+        d_.wall_key[i * kWallSlots + q] = q < nnew ? new_key[q] : -1;
+        d_.wall_eta[i * kWallSlots + q] = q < nnew ? new_eta[q] : 0.0;
+        d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
+      }
+      d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay;
+    }
+  }
+  n_contacts_ += nc_total;
+}
+
+void Simulation::reduce_to_bodies() {
+  const std::size_t nb = b_.x.size();
+  const Vec2 g = params_.gravity;
+#pragma omp parallel for schedule(static) num_threads(params_.threads)
+  for (std::size_t b = 0; b < nb; ++b) {
+    const int first = b_.first_disc[b], nd = b_.n_discs[b];
+    double fx = 0, fy = 0, tq = 0;
+    for (int k = first; k < first + nd; ++k) {
+      fx += d_.fx[k]; fy += d_.fy[k];
+      tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
+    }
+    b_.fx[b] = fx + b_.mass[b] * g.x;
+    b_.fy[b] = fy + b_.mass[b] * g.y;
+    b_.torque[b] = tq;
+  }
+  for (std::size_t k = 0; k < forces_.size(); ++k) {
+    std::fill(prov_fx_[k].begin(), prov_fx_[k].end(), 0.0);
+    std::fill(prov_fy_[k].begin(), prov_fy_[k].end(), 0.0);
+    std::fill(prov_tq_[k].begin(), prov_tq_[k].end(), 0.0);
+    forces_[k]->add(b_, d_, time_, prov_fx_[k], prov_fy_[k], prov_tq_[k]);
+    for (std::size_t b = 0; b < nb; ++b) {
+      b_.fx[b] += prov_fx_[k][b]; b_.fy[b] += prov_fy_[k][b]; b_.torque[b] += prov_tq_[k][b];
+    }
+  }
+}
+
+void Simulation::compute_forces() {
+  ensure_neighbor_list();
+  pair_forces();
+  wall_forces();
+  reduce_to_bodies();
+  forces_valid_ = true;
+}
+
+void Simulation::step() {
+  if (!forces_valid_) {
+    update_disc_positions(0, b_.x.size());
+    compute_forces();
+  }
+  const double dt = params_.dt;
+  const std::size_t nb = b_.x.size();
+  const bool periodic = params_.periodic_x;
+  const double xlo = params_.x_lo, L = params_.x_hi - params_.x_lo;
+  double* x = b_.x.data(); double* y = b_.y.data(); double* vx = b_.vx.data(); double* vy = b_.vy.data();
+  double* th = b_.theta.data(); double* om = b_.omega.data();
+  const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
+  const double* m = b_.mass.data(); const double* I = b_.inertia.data();
+  if (params_.integrator == Integrator::newmark_explicit) {
+    // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
+#pragma omp parallel for schedule(static) num_threads(params_.threads)
+    for (std::size_t b = 0; b < nb; ++b) {
+      const double ax = fx[b] / m[b], ay = fy[b] / m[b], al = tq[b] / I[b];
+      x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
+      th[b] += dt * om[b] + 0.5 * dt * dt * al;
+      vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
+      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
+    }
+  } else {
+    // velocity Verlet, first half: kick by dt/2, drift by dt
+#pragma omp parallel for schedule(static) num_threads(params_.threads)
+    for (std::size_t b = 0; b < nb; ++b) {
+      vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
+      x[b] += dt * vx[b]; y[b] += dt * vy[b]; th[b] += dt * om[b];
+      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
+    }
+  }
+  for (auto& w : walls_) w.advance(dt);
+  time_ += dt;
+  ++step_;
+  update_disc_positions(0, nb);
+  compute_forces();
+  if (params_.integrator == Integrator::velocity_verlet) {
+#pragma omp parallel for schedule(static) num_threads(params_.threads)
+    for (std::size_t b = 0; b < nb; ++b) {
+      vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
+    }
+  }
+}
+
+Energy Simulation::energy() const {
+  Energy e;
+  for (std::size_t b = 0; b < b_.x.size(); ++b) {
+    e.kinetic += 0.5 * b_.mass[b] * (b_.vx[b] * b_.vx[b] + b_.vy[b] * b_.vy[b]) + 0.5 * b_.inertia[b] * b_.omega[b] * b_.omega[b];
+    e.gravity -= b_.mass[b] * (params_.gravity.x * b_.x[b] + params_.gravity.y * b_.y[b]);
+  }
+  const auto& cp = params_.interactions[0].contact;
+  const double L = params_.x_hi - params_.x_lo;
+  for (std::size_t i = 0; i + 1 < nlist_.row_start_.size(); ++i) {
+    for (int k = nlist_.row_start_[i]; k < nlist_.row_start_[i + 1]; ++k) {
+      const int j = nlist_.nbr_[k];
+      double dx = d_.x[i] - d_.x[j];
+      if (params_.periodic_x) dx -= L * std::nearbyint(dx / L);
+      const double dy = d_.y[i] - d_.y[j];
+      const double ov = d_.r[i] + d_.r[j] - std::sqrt(dx * dx + dy * dy);
+      if (ov > 0) e.elastic += 0.5 * cp.k * ov * ov + 0.5 * cp.ks * nlist_.eta_[k] * nlist_.eta_[k];
+    }
+  }
+  std::vector<geometry::WallHit> hits;
+  for (std::size_t i = 0; i < d_.x.size(); ++i) {
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      hits.clear();
+      walls_[w].query({d_.x[i], d_.y[i]}, d_.r[i], 0.0, hits);
+      const auto& wc = params_.interactions[walls_[w].interaction].contact;
+      for (auto& h : hits) {
+        if (h.gap >= 0) continue;
+        e.elastic += 0.5 * wc.k * h.gap * h.gap;
+        const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+        for (int q = 0; q < kWallSlots; ++q)
+          if (d_.wall_key[i * kWallSlots + q] == key) e.elastic += 0.5 * wc.ks * std::pow(d_.wall_eta[i * kWallSlots + q], 2);
+      }
+    }
+  }
+  return e;
+}
+
+// ---- checkpoint serialisation (raw little-endian doubles; same binary, same machine kind) ----
+namespace {
+constexpr std::uint64_t kMagic = 0x314b43504d454450ULL;  // "PDEMPCK1"
+template <class T> void put(std::ostream& o, const T& v) { o.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+template <class T> void put_vec(std::ostream& o, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  put(o, n);
+  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
+}
+template <class T> void get(std::istream& i, T& v) {
+  if (!i.read(reinterpret_cast<char*>(&v), sizeof(T))) throw std::runtime_error("checkpoint truncated");
+}
+template <class T> void get_vec(std::istream& i, std::vector<T>& v) {
+  std::uint64_t n;
+  get(i, n);
+  if (n > (1ULL << 34)) throw std::runtime_error("checkpoint corrupt (vector size)");
+  v.resize(n);
+  if (!i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))))
+    throw std::runtime_error("checkpoint truncated");
+}
+}  // namespace
+
+void Simulation::save(std::ostream& o) const {
+  put(o, kMagic);
+  put(o, time_); put(o, step_); put(o, next_id_);
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
+                  &b_.inertia, &b_.size}) put_vec(o, *v);
+  put_vec(o, b_.id); put_vec(o, b_.first_disc); put_vec(o, b_.n_discs); put_vec(o, b_.tag);
+  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
+    put_vec(o, *v);
+  put_vec(o, d_.body); put_vec(o, d_.wall_key); put_vec(o, d_.wall_eta); put_vec(o, d_.wall_slide);
+  put_vec(o, nlist_.row_start_); put_vec(o, nlist_.nbr_); put_vec(o, nlist_.eta_); put_vec(o, nlist_.slide_);
+  const std::uint64_t nw = walls_.size();
+  put(o, nw);
+  for (const auto& w : walls_) put(o, w.angle);
+  const std::uint64_t np = prov_fx_.size();
+  put(o, np);
+  for (std::size_t k = 0; k < np; ++k) { put_vec(o, prov_fx_[k]); put_vec(o, prov_fy_[k]); put_vec(o, prov_tq_[k]); }
+  put(o, n_contacts_);
+}
+
+void Simulation::load(std::istream& in) {
+  std::uint64_t magic;
+  get(in, magic);
+  if (magic != kMagic) throw std::runtime_error("not a nipdem checkpoint (bad magic)");
+  get(in, time_); get(in, step_); get(in, next_id_);
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
+                  &b_.inertia, &b_.size}) get_vec(in, *v);
+  get_vec(in, b_.id); get_vec(in, b_.first_disc); get_vec(in, b_.n_discs); get_vec(in, b_.tag);
+  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
+    get_vec(in, *v);
+  get_vec(in, d_.body); get_vec(in, d_.wall_key); get_vec(in, d_.wall_eta); get_vec(in, d_.wall_slide);
+  get_vec(in, nlist_.row_start_); get_vec(in, nlist_.nbr_); get_vec(in, nlist_.eta_); get_vec(in, nlist_.slide_);
+  std::uint64_t nw;
+  get(in, nw);
+  if (nw != walls_.size()) throw std::runtime_error("checkpoint has a different number of walls than the configuration");
+  for (auto& w : walls_) get(in, w.angle);
+  std::uint64_t np;
+  get(in, np);
+  if (np != prov_fx_.size()) throw std::runtime_error("checkpoint has a different number of force providers than the configuration");
+  for (std::size_t k = 0; k < np; ++k) { get_vec(in, prov_fx_[k]); get_vec(in, prov_fy_[k]); get_vec(in, prov_tq_[k]); }
+  get(in, n_contacts_);
+  // The list is rebuilt (history carried over by identity mapping) at the next evaluation;
+  // forces of the saved state are already in the body arrays.
+  old_of_new_.resize(d_.x.size());
+  for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
+  structure_changed_ = true;
+  forces_valid_ = true;
+}
+
+}  // namespace nipdem::engine

@@ -1,0 +1,123 @@
+#include "nipdem/geometry/walls.hpp"
+
+#include <cmath>
+
+#include "nipdem/core/constants.hpp"
+#include "nipdem/core/error.hpp"
+
+namespace nipdem::geometry {
+
+double Wall::period() const { return profile.empty() ? 0.0 : profile.back().x; }
+
+Vec2 Wall::profile_point(int k, Vec2 sd) const {
+  const double s = k * period() + sd.x + phase;
+  const double phi = s / radius + angle;
+  const double rr = radius - sd.y;
+  return centre + Vec2{rr * std::cos(phi), rr * std::sin(phi)};
+}
+
+namespace {
+// Closest point on segment [a, b] to c; t in [0, 1].
+inline Vec2 closest_on_segment(Vec2 a, Vec2 b, Vec2 c, double& t) {
+  const Vec2 ab = b - a;
+  const double l2 = norm2(ab);
+  t = l2 > 0.0 ? dot(c - a, ab) / l2 : 0.0;
+  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+  return a + t * ab;
+}
+}  // namespace
+
+void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const {
+  if (kind == Kind::plane) {
+    const double dist = dot(c - point, normal);
+    const double gap = dist - r;
+    if (gap <= reach) hits.push_back({0, c - dist * normal, normal, gap, surface_velocity});
+    return;
+  }
+  const Vec2 d = c - centre;
+  const double dist = norm(d);
+  if (!rough()) {
+    if (dist <= 0.0) return;
+    const Vec2 u = d / dist;
+    const double gap = inside ? (radius - dist - r) : (dist - radius - r);
+    if (gap > reach) return;
+    const Vec2 n = inside ? -u : u;
+    const Vec2 q = centre + radius * u;
+    hits.push_back({0, q, n, gap, cross(omega, q - centre)});
+    return;
+  }
+  // Rough cylinder (discs outside). Quick reject on the base circle.
+  if (dist - radius - r > reach) return;
+  const double P = period();
+  const double circumference = P * n_periods;
+  double phi = std::atan2(d.y, d.x) - angle;
+  double s = phi * radius - phase;
+  s = std::fmod(s, circumference);
+  if (s < 0) s += circumference;
+  const int k0 = static_cast<int>(std::floor(s / P));
+  const int m = static_cast<int>(profile.size()) - 1;  // segments per period
+  for (int dk = -1; dk <= 1; ++dk) {
+    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+    // wrap so the profile points are evaluated near the disc (avoid 2 pi jumps)
+    for (int j = 0; j < m; ++j) {
+      const Vec2 a = profile_point(k, profile[j]);
+      const Vec2 b = profile_point(k, profile[j + 1]);
+      double t;
+      const Vec2 q = closest_on_segment(a, b, c, t);
+      // Interior contacts only; convex vertices are handled below, concave vertices are
+      // covered by the interiors of their two faces.
+      if (t <= 0.0 || t >= 1.0) continue;
+      const Vec2 dq = c - q;
+      const double dd = norm(dq);
+      const double gap = dd - r;
+      if (gap > reach || dd <= 0.0) continue;
+      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, dq / dd, gap, cross(omega, q - centre)});
+    }
+    for (int j = 0; j < m; ++j) {
+      // Vertex j is convex (seen from outside) if the profile turns towards the axis there:
+      // depth increases on the following segment relative to the straight continuation.
+      const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - P, profile[m - 1].y} : profile[j - 1];
+      const Vec2 cur = profile[j], next = profile[j + 1];
+      if (cross(cur - prev, next - cur) <= 0.0) continue;  // concave or straight
+      const Vec2 v = profile_point(k, cur);
+      const Vec2 dq = c - v;
+      const double dd = norm(dq);
+      const double gap = dd - r;
+      if (gap > reach || dd <= 0.0) continue;
+      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, dq / dd, gap, cross(omega, v - centre)});
+    }
+  }
+}
+
+void Wall::validate() const {
+  const std::string where = "wall '" + name + "'";
+  if (kind == Kind::plane) {
+    if (std::fabs(norm(normal) - 1.0) > 1e-9) throw_input(where, "normal", "", "must be a unit vector");
+    return;
+  }
+  require_positive(where, "radius_m", radius);
+  if (!profile.empty()) {
+    if (inside) throw_input(where, "roughness", "", "roughness is only supported on the outside of a cylinder");
+    if (profile.size() < 2 || profile.front().x != 0.0) throw_input(where, "profile", "", "must start at s = 0 with >= 2 vertices");
+    if (profile.front().y != profile.back().y) throw_input(where, "profile", "", "first and last depth must be equal (periodic)");
+    for (std::size_t i = 1; i < profile.size(); ++i) {
+      if (!(profile[i].x > profile[i - 1].x)) throw_input(where, "profile", "", "arc length s must increase");
+      if (profile[i].y < 0.0) throw_input(where, "profile", "", "depth must be >= 0");
+    }
+    if (n_periods < 3) throw_input(where, "n_periods", std::to_string(n_periods), "too few periods", ">= 3");
+    if (std::fabs(period() * n_periods - 2.0 * constants::pi * radius) > 1e-9 * radius)
+      throw_input(where, "profile", "", "period * n_periods must equal the circumference");
+  }
+}
+
+void set_pyramid_roughness(Wall& w, double height, double base, double spacing) {
+  const double nominal = spacing + base;
+  const double circumference = 2.0 * constants::pi * w.radius;
+  w.n_periods = static_cast<int>(std::lround(circumference / nominal));
+  if (w.n_periods < 3) throw_input("wall '" + w.name + "'", "roughness", "", "period longer than a third of the circumference");
+  const double scale = circumference / (w.n_periods * nominal);  // stretch to fit exactly
+  const double L = spacing * scale, B = base * scale;
+  w.profile = {{0.0, 0.0}, {L, 0.0}, {L + 0.5 * B, height}, {L + B, 0.0}};
+}
+
+}  // namespace nipdem::geometry

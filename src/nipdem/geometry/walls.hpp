@@ -1,0 +1,70 @@
+// Boundary surfaces the discs collide with: planes, smooth cylinders (a roller modelled as one
+// large disc, thesis §2.1) and cylinders carrying a periodic chain of line pieces (the
+// imaging-roller roughness, §2.1, figs 2.6-2.7). A cylinder rotates about its axis at a
+// prescribed angular speed; its line pieces are attached to it and move with it.
+// Queries return every contact "feature" within reach of a disc: a line piece (segment) or
+// a convex vertex of the chain, each with a stable key so tangential history follows the
+// feature as the roller turns.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "nipdem/core/vec2.hpp"
+
+namespace nipdem::geometry {
+
+struct WallHit {
+  std::int64_t key;   // stable feature id within this wall
+  Vec2 point;         // closest point on the surface [m]
+  Vec2 normal;        // unit normal from the surface towards the disc centre
+  double gap;         // surface separation: distance(centre, point) - r [m] (< 0: overlap)
+  Vec2 velocity;      // velocity of the surface material at `point` [m/s]
+};
+
+struct Wall {
+  enum class Kind { plane, cylinder };
+  Kind kind = Kind::plane;
+  std::string name;
+  int interaction = 0;  // index of the interaction (contact + adhesion parameters)
+
+  // plane: point on the plane and unit normal pointing into the domain; the surface moves
+  // tangentially with `surface_velocity` (a conveyor).
+  Vec2 point{}, normal{0, 1};
+  Vec2 surface_velocity{};
+
+  // cylinder: axis position, radius, angular velocity (counter-clockwise positive) and
+  // current rotation angle. Discs live outside (a roller) unless `inside` (a container).
+  Vec2 centre{};
+  double radius = 0.0;
+  double omega = 0.0;
+  double angle = 0.0;
+  bool inside = false;
+
+  // Optional roughness on a cylinder: one period of a closed profile given as vertices
+  // (s, depth) with s the arc length along the base circle [0, period] and depth measured
+  // into the cylinder (>= 0). The first and last vertex must have the same depth; the
+  // profile repeats n_periods times around the circumference (period * n_periods = 2 pi R).
+  std::vector<Vec2> profile;  // (s, depth) pairs [m]
+  int n_periods = 0;
+  double phase = 0.0;         // arc-length offset of period 0 at angle 0 [m]
+
+  double period() const;
+  bool rough() const { return !profile.empty(); }
+  // Appends all features within `reach` of a disc (centre c, radius r) to hits.
+  void query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const;
+  // Advances the prescribed motion by dt.
+  void advance(double dt) { angle += omega * dt; }
+  // World position of profile point (s, depth) in period k, at the current angle.
+  Vec2 profile_point(int k, Vec2 sd) const;
+  // Validates the geometry; throws InputError naming the wall and key.
+  void validate() const;
+};
+
+// The pyramid roughness of the imaging roller cut along the diagonal (thesis §2.1, fig. 2.6):
+// flat land of length `spacing`, then a V-shaped pit of width `base` and depth `height`.
+// The period is adjusted so that an integer number fits the circumference; returns the
+// profile and sets n_periods on the wall. See docs/geometry.md.
+void set_pyramid_roughness(Wall& w, double height, double base, double spacing);
+
+}  // namespace nipdem::geometry
