@@ -1,0 +1,237 @@
+#include "nipdem/experiments/nip.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "nipdem/core/constants.hpp"
+#include "nipdem/core/error.hpp"
+#include "nipdem/geometry/walls.hpp"
+
+namespace nipdem::experiments {
+
+using constants::pi;
+
+Vec2 NipRun::drum_centre() const { return {cfg_.nip_x, cfg_.gap + cfg_.drum_radius}; }
+Vec2 NipRun::roller_centre() const { return {cfg_.nip_x, -cfg_.roller_radius}; }
+double NipRun::drum_surface_y(double x) const {
+  const double dx = x - cfg_.nip_x;
+  return drum_centre().y - std::sqrt(cfg_.drum_radius * cfg_.drum_radius - dx * dx);
+}
+double NipRun::roller_surface_y(double x) const {
+  const double dx = x - cfg_.nip_x;
+  return roller_centre().y + std::sqrt(cfg_.roller_radius * cfg_.roller_radius - dx * dx);
+}
+
+NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)), rng_(cfg_.seed) {
+  tmpl_ = &find_template(cfg_.templates, cfg_.cluster, cfg_.file, "toner.cluster");
+  engine::EngineParams p;
+  p.integrator = cfg_.integrator;
+  p.dt = ts_.dt;
+  p.gravity = cfg_.gravity;
+  p.interactions = make_interactions(cfg_);
+  p.skin = 0.1 * cfg_.size.d50;
+  p.threads = cfg_.threads;
+
+  geometry::Wall roller;
+  roller.kind = geometry::Wall::Kind::cylinder;
+  roller.name = "imaging_roller";
+  roller.centre = roller_centre();
+  roller.radius = cfg_.roller_radius;
+  // Surface at the top moves towards +x: clockwise rotation (omega < 0).
+  roller.omega = -cfg_.roller_speed / cfg_.roller_radius;
+  roller.interaction = 1;
+  if (cfg_.roughness && cfg_.rough_height > 0.0) geometry::set_pyramid_roughness(roller, cfg_.rough_height, cfg_.rough_base, cfg_.rough_spacing);
+  geometry::Wall drum;
+  drum.kind = geometry::Wall::Kind::cylinder;
+  drum.name = "di_drum";
+  drum.centre = drum_centre();
+  drum.radius = cfg_.drum_radius;
+  // Surface at the bottom moves towards -x: omega * R * (+x) at the bottom point => omega < 0.
+  drum.omega = -cfg_.drum_speed / cfg_.drum_radius;
+  drum.interaction = 2;
+  sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
+  if (cfg_.prefill) prefill();
+}
+
+bool NipRun::try_insert(double x_lo, double x_hi) {
+  const double d = cfg_.size.sample(rng_);
+  engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
+  const double angle = rng_.uniform(0.0, 2.0 * pi);
+  double extent = 0.0;
+  for (std::size_t k = 0; k < spec.radii.size(); ++k) extent = std::max(extent, norm(spec.offsets[k]) + spec.radii[k]);
+  const double x = rng_.uniform(x_lo, x_hi);
+  // within the layer under the drum surface, not touching it
+  const double ytop = drum_surface_y(x) - extent - 1e-8;
+  const double ybot = std::max(drum_surface_y(x) - cfg_.layer_thickness + extent, roller_surface_y(x) + extent + 1e-8);
+  if (ytop < ybot) return false;
+  const double y = rng_.uniform(ybot, ytop);
+  // world discs of the candidate (offsets are about an arbitrary origin; use the COM shift)
+  double m = 0;
+  Vec2 com{};
+  for (std::size_t k = 0; k < spec.radii.size(); ++k) {
+    const double mk = std::pow(spec.radii[k], 3);
+    m += mk;
+    com += mk * spec.offsets[k];
+  }
+  com /= m;
+  const Vec2 pos{x, y};
+  std::vector<Vec2> pts;
+  for (auto& o : spec.offsets) pts.push_back(pos + rotate(o - com, angle));
+  // overlap with walls (roughness pits are below the base circle: the base test suffices)
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    if (norm(pts[k] - drum_centre()) < cfg_.drum_radius + spec.radii[k]) return false;
+    if (norm(pts[k] - roller_centre()) < cfg_.roller_radius + spec.radii[k]) return false;
+  }
+  // overlap with existing discs nearby
+  const auto& dd = sim_->discs();
+  const double reach = x_hi - x_lo + 2.0 * extent + cfg_.size.d_max();
+  for (std::size_t i = 0; i < dd.x.size(); ++i) {
+    if (std::fabs(dd.x[i] - x) > reach) continue;
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double rr = dd.r[i] + spec.radii[k];
+      const double dx = dd.x[i] - pts[k].x, dy = dd.y[i] - pts[k].y;
+      if (dx * dx + dy * dy < rr * rr) return false;
+    }
+  }
+  spec.position = pos;
+  spec.angle = angle;
+  // Move with the drum surface (rigid rotation about the drum axis).
+  const auto& drum = sim_->walls()[1];
+  spec.velocity = cross(drum.omega, pos - drum.centre);
+  spec.omega = drum.omega;
+  spec.tag = 0;
+  // offsets relative to their own centroid; the engine recentres on the mass centre
+  sim_->add_body(spec);
+  ++inserted_;
+  return true;
+}
+
+void NipRun::prefill() {
+  // Fill the layer over the whole window at the target area fraction.
+  const double width = cfg_.x_max - cfg_.x_min;
+  double area = cfg_.layer_thickness * cfg_.area_fraction * width;
+  const double a50 = pi * cfg_.size.d50 * cfg_.size.d50 / 4.0;
+  int failures = 0;
+  while (area > 0.5 * a50 && failures < 20000) {
+    const auto before = inserted_;
+    if (try_insert(cfg_.x_min, cfg_.x_max)) {
+      const double d = sim_->bodies().size.back();
+      area -= pi * d * d / 4.0;
+    } else {
+      ++failures;
+    }
+    (void)before;
+  }
+}
+
+void NipRun::exchange() {
+  auto& b = sim_->bodies();
+  const double t = sim_->time();
+  // Outflow: bodies whose centre of mass left the window, classified by the nearer surface.
+  const Vec2 cd = drum_centre(), cr = roller_centre();
+  const double rough = cfg_.roughness ? cfg_.rough_height : 0.0;
+  sim_->remove_bodies_if([&](int i) {
+    const Vec2 p{b.x[i], b.y[i]};
+    const double gd = norm(p - cd) - cfg_.drum_radius;
+    const double gr = norm(p - cr) - cfg_.roller_radius;
+    const bool escaped = gd < -0.5 * cfg_.size.d50 || gr < -rough - 0.5 * cfg_.size.d50 || !std::isfinite(p.x) || !std::isfinite(p.y);
+    const bool outside = p.x < cfg_.x_min || p.x > cfg_.x_max;
+    if (!escaped && !outside) return false;
+    const Exit e = escaped ? Exit::lost : (gd < gr ? Exit::developed : Exit::returned);
+    removals_.push_back({t, e, p.x, p.y, b.size[i], b.id[i]});
+    ++removed_[static_cast<int>(e)];
+    return true;
+  });
+  // Inflow: area flux layer_thickness * area_fraction * drum speed through x_max.
+  area_debt_ += cfg_.layer_thickness * cfg_.area_fraction * std::fabs(cfg_.drum_speed) * ts_.dt * cfg_.insert_interval;
+  const double zone = std::max(2.0 * cfg_.size.d_max(), std::fabs(cfg_.drum_speed) * ts_.dt * cfg_.insert_interval * 2.0);
+  int attempts = 0;
+  while (area_debt_ > 0.0 && attempts < 200) {
+    ++attempts;
+    if (try_insert(cfg_.x_max - zone, cfg_.x_max - 0.5 * cfg_.size.d_max())) {
+      const double d = b.size.back();
+      area_debt_ -= pi * d * d / 4.0;
+    }
+  }
+  // A full zone leaves the debt to the next pass; do not let it grow without bound.
+  area_debt_ = std::min(area_debt_, 10.0 * pi * cfg_.size.d_max() * cfg_.size.d_max());
+}
+
+void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) {
+  while (sim_->time() < t_end - 0.5 * ts_.dt) {
+    const std::int64_t n = std::min<std::int64_t>(cfg_.insert_interval - sim_->step_count() % cfg_.insert_interval,
+                                                   static_cast<std::int64_t>(std::ceil((t_end - sim_->time()) / ts_.dt - 0.5)));
+    for (std::int64_t i = 0; i < n; ++i) sim_->step();
+    if (sim_->step_count() % cfg_.insert_interval == 0) exchange();
+    if (on_interval) on_interval();
+  }
+}
+
+// ---- checkpoint ----
+namespace {
+template <class T> void put(std::string& s, const T& v) { s.append(reinterpret_cast<const char*>(&v), sizeof(T)); }
+template <class T> void get(const std::string& s, std::size_t& pos, T& v) {
+  if (pos + sizeof(T) > s.size()) throw std::runtime_error("checkpoint truncated");
+  std::memcpy(&v, s.data() + pos, sizeof(T));
+  pos += sizeof(T);
+}
+}  // namespace
+
+std::string NipRun::checkpoint() const {
+  std::string s = "NIPDEMRUN1";
+  const std::uint64_t h = std::hash<std::string>{}(cfg_.resolved_toml);
+  put(s, h);
+  for (int i = 0; i < 4; ++i) put(s, rng_.state()[i]);
+  put(s, inserted_);
+  for (auto r : removed_) put(s, r);
+  put(s, area_debt_);
+  const std::uint64_t nr = removals_.size();
+  put(s, nr);
+  for (const auto& e : removals_) put(s, e);
+  std::ostringstream os;
+  sim_->save(os);
+  s += os.str();
+  return s;
+}
+
+void NipRun::restore(const std::string& blob) {
+  if (blob.compare(0, 10, "NIPDEMRUN1") != 0) throw std::runtime_error("not a nipdem run checkpoint");
+  std::size_t pos = 10;
+  std::uint64_t h;
+  get(blob, pos, h);
+  if (h != std::hash<std::string>{}(cfg_.resolved_toml))
+    throw InputError("checkpoint was written with a different configuration; resume needs the same config and --set options");
+  std::uint64_t st[4];
+  for (auto& v : st) get(blob, pos, v);
+  rng_.set_state(st);
+  get(blob, pos, inserted_);
+  for (auto& r : removed_) get(blob, pos, r);
+  get(blob, pos, area_debt_);
+  std::uint64_t nr;
+  get(blob, pos, nr);
+  removals_.resize(nr);
+  for (auto& e : removals_) get(blob, pos, e);
+  std::istringstream is(blob.substr(pos));
+  sim_->load(is);
+}
+
+nlohmann::json NipRun::describe() const {
+  const auto& w = sim_->walls();
+  nlohmann::json prof = nlohmann::json::array();
+  for (auto& p : w[0].profile) prof.push_back({p.x, p.y});
+  return {
+      {"drum", {{"centre_m", {w[1].centre.x, w[1].centre.y}}, {"radius_m", w[1].radius}, {"omega_rad_per_s", w[1].omega}}},
+      {"roller",
+       {{"centre_m", {w[0].centre.x, w[0].centre.y}},
+        {"radius_m", w[0].radius},
+        {"omega_rad_per_s", w[0].omega},
+        {"profile_s_depth_m", prof},
+        {"n_periods", w[0].n_periods},
+        {"phase_m", w[0].phase}}},
+      {"window_x_m", {cfg_.x_min, cfg_.x_max}},
+      {"gap_m", cfg_.gap},
+  };
+}
+
+}  // namespace nipdem::experiments

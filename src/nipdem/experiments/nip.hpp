@@ -1,0 +1,79 @@
+// A nip simulation: DI-drum and imaging roller (with line-piece roughness) around a window of
+// the development nip, toner flowing in on the drum, particles removed and counted where they
+// leave (thesis §2.1, §4.1, §5.1).
+//
+// Coordinates (docs/geometry.md): x along the process direction with the origin at the
+// magnet edge on the imaging-roller surface, positive towards the supply roller; y from the
+// roller surface towards the drum. The roller axis is at (nip_x, -R_roller), the drum axis at
+// (nip_x, gap + R_drum). In the nip the drum surface moves towards -x (carrying developed
+// toner out of the nip) and the sleeve towards +x (returning toner to the supply roller).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/core/rng.hpp"
+#include "nipdem/engine/simulation.hpp"
+#include "nipdem/experiments/nip_config.hpp"
+
+namespace nipdem::experiments {
+
+enum class Exit { developed = 0, returned = 1, lost = 2 };
+
+struct RemovalEvent {
+  double time;      // [s]
+  Exit where;
+  double x, y;      // centre of mass when removed [m]
+  double size;      // volume-equivalent diameter [m]
+  std::int64_t id;
+};
+
+class NipRun {
+ public:
+  explicit NipRun(NipConfig cfg);
+
+  // Advances to time t_end, calling `on_step` every insert interval (for progress).
+  void advance_to(double t_end, const std::function<void()>& on_interval = {});
+  // One inflow/outflow pass (also done automatically every interval).
+  void exchange();
+
+  engine::Simulation& sim() { return *sim_; }
+  const engine::Simulation& sim() const { return *sim_; }
+  const NipConfig& config() const { return cfg_; }
+  const TimeStep& time_step() const { return ts_; }
+  std::int64_t inserted() const { return inserted_; }
+  std::int64_t removed(Exit e) const { return removed_[static_cast<int>(e)]; }
+  const std::vector<RemovalEvent>& removals() const { return removals_; }
+
+  // Geometry helpers.
+  Vec2 drum_centre() const;
+  Vec2 roller_centre() const;
+  double drum_surface_y(double x) const;    // y of the drum surface above x
+  double roller_surface_y(double x) const;  // y of the base circle of the roller below x
+
+  // Checkpoint of the whole run (engine + runner state) and its restore.
+  std::string checkpoint() const;
+  void restore(const std::string& blob);
+  // Geometry and parameters for summary.json / rendering.
+  nlohmann::json describe() const;
+
+ private:
+  bool try_insert(double x_lo, double x_hi);
+  void prefill();
+
+  NipConfig cfg_;
+  TimeStep ts_;
+  std::unique_ptr<engine::Simulation> sim_;
+  Rng rng_;
+  std::int64_t inserted_ = 0;
+  std::int64_t removed_[3] = {0, 0, 0};
+  double area_debt_ = 0.0;  // toner area still to insert [m^2]
+  std::vector<RemovalEvent> removals_;
+  const ClusterTemplate* tmpl_ = nullptr;
+};
+
+}  // namespace nipdem::experiments

@@ -1,0 +1,244 @@
+#include "nipdem/experiments/nip_config.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "nipdem/core/constants.hpp"
+#include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/toml_reader.hpp"
+
+namespace nipdem::experiments {
+
+using constants::pi;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+namespace {
+CollisionType read_collision(io::Section s, CollisionType def) {
+  CollisionType c;
+  c.restitution = s.number("restitution", 0.01, 1.0, def.restitution);
+  c.k = s.number("k_N_per_m", 1e-6, 1e9, def.k);
+  c.mu_s = s.number("mu_s", 0.0, 10.0, def.mu_s);
+  c.mu_d = s.number("mu_d", 0.0, 10.0, def.mu_d);
+  if (c.mu_d > c.mu_s) throw_input(s.file(), s.key_path("mu_d"), fmt::format("{:g}", c.mu_d), "dynamic friction must not exceed static", fmt::format("[0, mu_s = {:g}]", c.mu_s));
+  s.finish();
+  return c;
+}
+}  // namespace
+
+NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+  toml::table root = io::parse_toml(text, file);
+  for (const auto& o : overrides) io::apply_override(root, o, file);
+  NipConfig c;
+  c.file = file;
+  io::Section top(&root, file, "");
+
+  {
+    auto s = top.sub("run");
+    c.seed = static_cast<std::uint64_t>(s.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
+    c.end_time = s.number("end_time_s", 0.0, 10.0, c.end_time);
+    c.output_interval = s.number("output_interval_s", 1e-9, 10.0, c.output_interval);
+    c.checkpoint_interval = s.number("checkpoint_interval_s", 1e-9, 10.0, c.checkpoint_interval);
+    c.threads = static_cast<int>(s.integer("threads", 1, 256, 1));
+    c.integrator = s.choice("integrator", {"velocity_verlet", "newmark_explicit"}, "velocity_verlet") == "velocity_verlet"
+                       ? engine::Integrator::velocity_verlet : engine::Integrator::newmark_explicit;
+    c.dt = s.number("dt_s", 0.0, 1e-3, 0.0);
+    c.dt_fraction = s.number("dt_fraction_of_contact_time", 1e-4, 0.5, c.dt_fraction);
+    s.finish();
+  }
+  {
+    auto s = top.sub("geometry");
+    c.gap = s.number("gap_m", 1e-6, 5e-3, c.gap);
+    c.drum_radius = s.number("drum_radius_m", 1e-3, 1.0, c.drum_radius);
+    c.roller_radius = s.number("roller_radius_m", 1e-3, 1.0, c.roller_radius);
+    c.drum_speed = s.number("drum_surface_speed_m_per_s", -100.0, 100.0, c.drum_speed);
+    c.roller_speed = s.number("roller_surface_speed_m_per_s", -100.0, 100.0, c.roller_speed);
+    c.nip_x = s.number("nip_x_m", -0.01, 0.01, c.nip_x);
+    c.x_min = s.number("window_x_min_m", -0.01, 0.0, c.x_min);
+    c.x_max = s.number("window_x_max_m", 0.0, 0.01, c.x_max);
+    if (c.x_max - c.x_min < 50e-6) throw_input(file, "geometry.window_x_max_m", fmt::format("{:g}", c.x_max), "window narrower than 50 um", "window_x_max_m - window_x_min_m >= 5e-5");
+    auto r = s.sub("roughness");
+    c.roughness = r.boolean("enabled", true);
+    c.rough_height = r.number("height_m", 0.0, 1e-3, c.rough_height);
+    c.rough_base = r.number("base_m", 1e-7, 1e-2, c.rough_base);
+    c.rough_spacing = r.number("spacing_m", 0.0, 1e-2, c.rough_spacing);
+    r.finish();
+    s.finish();
+  }
+  {
+    auto s = top.sub("toner");
+    c.size.d_small = s.number("d_small_m", 1e-7, 1e-3, c.size.d_small);
+    c.size.d50 = s.number("d50_m", 1e-7, 1e-3, c.size.d50);
+    c.size.d_large = s.number("d_large_m", 1e-7, 1e-3, c.size.d_large);
+    c.size.number_weighted = s.choice("size_weighting", {"number", "volume"}, "number") == "number";
+    c.size.validate(file);
+    c.density = s.number("density_kg_per_m3", 1.0, 1e5, c.density);
+    c.cluster = s.string("cluster", c.cluster);
+    c.cluster_file = s.string("cluster_file", "");
+    s.finish();
+  }
+  if (c.cluster_file.empty()) {
+    c.templates = builtin_templates();
+  } else {
+    c.templates = parse_templates(io::read_file(c.cluster_file), c.cluster_file);
+  }
+  find_template(c.templates, c.cluster, file, "toner.cluster");
+  {
+    auto s = top.sub("collision");
+    c.stiffness_scale = s.number("stiffness_scale", 1e-6, 1.0, 1.0);
+    c.damping = s.choice("damping_convention", {"physical", "thesis"}, "physical") == "physical"
+                    ? models::DampingConvention::physical : models::DampingConvention::thesis;
+    c.tt = read_collision(s.sub("toner_toner"), {0.85, 56, 0.47, 0.19});
+    c.ti = read_collision(s.sub("toner_roller"), {0.58, 117, 0.58, 0.40});
+    c.td = read_collision(s.sub("toner_drum"), {0.95, 126, 0.53, 0.34});
+    s.finish();
+  }
+  {
+    auto s = top.sub("adhesion");
+    c.adhesion_distance = s.choice("distance", {"surface", "centre"}, "surface") == "surface"
+                              ? models::HamakerParams::Distance::surface : models::HamakerParams::Distance::centre;
+    c.min_separation = s.number("min_separation_m", 1e-11, 1e-6, c.min_separation);
+    c.adhesion_cutoff = s.number("cutoff_m", 0.0, 1e-4, c.adhesion_cutoff);
+    c.adhesion_roller_force = s.number("roller_force_N", 0.0, 1e-3, c.adhesion_roller_force);
+    c.adhesion_drum_force = s.number("drum_force_N", 0.0, 1e-3, c.adhesion_drum_force);
+    c.cohesion_ratio = s.number("cohesion_ratio", 0.0, 1e6, c.cohesion_ratio);
+    s.finish();
+  }
+  {
+    auto s = top.sub("inflow");
+    c.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-3, c.layer_thickness);
+    c.area_fraction = s.number("area_fraction", 0.0, 0.85, c.area_fraction);
+    c.insert_interval = static_cast<int>(s.integer("interval_steps", 1, 1000000, c.insert_interval));
+    c.prefill = s.boolean("prefill", c.prefill);
+    s.finish();
+  }
+  {
+    auto s = top.sub("gravity");
+    auto g = s.numbers("vector_m_per_s2", 2, -1e6, 1e6, {c.gravity.x, c.gravity.y});
+    c.gravity = {g[0], g[1]};
+    s.finish();
+  }
+  {
+    auto s = top.sub("output");
+    c.vtk = s.boolean("vtk", true);
+    s.finish();
+  }
+  top.finish();
+
+  // Cross-checks.
+  if (c.gap <= c.size.d_max())
+    throw_input(file, "geometry.gap_m", fmt::format("{:g}", c.gap), "gap smaller than the largest particle",
+                fmt::format("> {:g} (toner d_max = d50 + 3 sigma)", c.size.d_max()));
+  if (c.roughness && c.rough_height >= c.gap)
+    throw_input(file, "geometry.roughness.height_m", fmt::format("{:g}", c.rough_height), "roughness deeper than the gap", fmt::format("< gap_m = {:g}", c.gap));
+  if (c.layer_thickness > c.gap)
+    throw_input(file, "inflow.layer_thickness_m", fmt::format("{:g}", c.layer_thickness), "layer thicker than the gap", fmt::format("[0, {:g}]", c.gap));
+  if (c.x_max - c.nip_x > 0.5 * std::min(c.drum_radius, c.roller_radius) || c.nip_x - c.x_min > 0.5 * std::min(c.drum_radius, c.roller_radius))
+    throw_input(file, "geometry.window_x_max_m", fmt::format("{:g}", c.x_max), "window reaches beyond half a roller radius from the nip");
+  std::ostringstream ss;
+  ss << root;
+  c.resolved_toml = ss.str();
+  choose_time_step(c);  // refuses a time step above the stability bound
+  return c;
+}
+
+NipConfig load_nip_config(const std::string& path, const std::vector<std::string>& overrides) {
+  return parse_nip_config(io::read_file(path), path, overrides);
+}
+
+double toner_mass(const NipConfig& c, double d) { return c.density * pi * d * d * d / 6.0; }
+
+std::vector<engine::Interaction> make_interactions(const NipConfig& c) {
+  const double m50 = toner_mass(c, c.size.d50);
+  models::HamakerParams base;
+  base.distance = c.adhesion_distance;
+  base.min_separation_m = c.min_separation;
+  base.cutoff_m = c.adhesion_cutoff;
+  const double r50 = 0.5 * c.size.d50;
+  auto make = [&](const char* name, const CollisionType& t, double mred, double adh_force, bool wall) {
+    engine::Interaction ia;
+    ia.name = name;
+    ia.contact.k = t.k * c.stiffness_scale;
+    ia.contact.gamma = models::gamma_from_restitution(ia.contact.k, mred, t.restitution, c.damping);
+    ia.contact.ks = 2.0 * ia.contact.k / 7.0;  // eq. 4.3.11 with c = 1
+    ia.contact.mu_s = t.mu_s;
+    ia.contact.mu_d = t.mu_d;
+    ia.adhesion = base;
+    // Hamaker coefficient from the force of a d50 toner at contact (eq. 2.3.2 inverted).
+    ia.adhesion.hamaker_J = adh_force > 0.0 ? models::hamaker_for_contact_force(base, r50, wall ? kInf : r50, adh_force) : 0.0;
+    return ia;
+  };
+  return {make("toner_toner", c.tt, m50 / 2, c.cohesion_ratio * c.adhesion_roller_force, false),
+          make("toner_roller", c.ti, m50, c.adhesion_roller_force, true),
+          make("toner_drum", c.td, m50, c.adhesion_drum_force, true)};
+}
+
+std::vector<CollisionReport> collision_report(const NipConfig& c) {
+  const auto ia = make_interactions(c);
+  const double m50 = toner_mass(c, c.size.d50);
+  const CollisionType* types[3] = {&c.tt, &c.ti, &c.td};
+  std::vector<CollisionReport> out;
+  for (int i = 0; i < 3; ++i) {
+    const double m = i == 0 ? m50 / 2 : m50;
+    const auto& cp = ia[i].contact;
+    out.push_back({ia[i].name, cp.k, cp.gamma, cp.ks, types[i]->restitution, models::contact_time(cp.k, cp.gamma, m),
+                   models::newmark_dt_max(cp.k, cp.gamma, m), models::verlet_dt_max(cp.k, cp.gamma, m), m,
+                   models::gamma_from_restitution(cp.k, m, types[i]->restitution, models::DampingConvention::thesis)});
+  }
+  return out;
+}
+
+TimeStep choose_time_step(const NipConfig& c) {
+  const auto ia = make_interactions(c);
+  // Smallest body: the smallest particle the size distribution can produce, with the
+  // rotational coupling of the cluster (effective mass at a contact point off the centre).
+  const ClusterTemplate& t = find_template(c.templates, c.cluster, c.file, "toner.cluster");
+  const double dmin = c.size.d_min();
+  const engine::BodySpec b = make_toner(t, dmin, c.density);
+  double m = 0, lever = 0, rmax = 0;
+  Vec2 com{};
+  for (std::size_t k = 0; k < b.radii.size(); ++k) {
+    const double mk = c.density * 4.0 / 3.0 * pi * std::pow(b.radii[k], 3);
+    m += mk;
+    com += mk * b.offsets[k];
+  }
+  com /= m;
+  double I = 0;
+  for (std::size_t k = 0; k < b.radii.size(); ++k) {
+    const double mk = c.density * 4.0 / 3.0 * pi * std::pow(b.radii[k], 3);
+    I += 0.4 * mk * b.radii[k] * b.radii[k] + mk * norm2(b.offsets[k] - com);
+    lever = std::max(lever, norm(b.offsets[k] - com));
+    rmax = std::max(rmax, norm(b.offsets[k] - com) + b.radii[k]);
+  }
+  const double m_n = 1.0 / (1.0 / m + lever * lever / I);  // normal direction, worst case
+  const double m_t = 1.0 / (1.0 / m + rmax * rmax / I);    // tangential direction, worst case
+  TimeStep ts{0.0, kInf, ""};
+  double tmin = kInf;
+  for (int i = 0; i < 3; ++i) {
+    const double mn = i == 0 ? m_n / 2 : m_n, mt = i == 0 ? m_t / 2 : m_t;
+    const auto& cp = ia[i].contact;
+    tmin = std::min(tmin, models::contact_time(cp.k, cp.gamma, mn));
+    double bound;
+    if (c.integrator == engine::Integrator::newmark_explicit) {
+      bound = models::newmark_dt_max(cp.k, cp.gamma, mn);  // eq. 4.2.25
+    } else {
+      // the stiffer of the normal and the tangential mode
+      const double kn_over_m = std::max(cp.k / mn, cp.ks / mt);
+      bound = models::verlet_dt_max(kn_over_m * mn, cp.gamma, mn);
+    }
+    if (bound < ts.bound) { ts.bound = bound; ts.limiting = ia[i].name; }
+  }
+  ts.dt = c.dt > 0.0 ? c.dt : c.dt_fraction * tmin;
+  if (ts.dt > ts.bound)
+    throw_input(c.file, c.dt > 0.0 ? "run.dt_s" : "run.dt_fraction_of_contact_time", fmt::format("{:g}", c.dt > 0 ? c.dt : c.dt_fraction),
+                fmt::format("time step {:.3g} s exceeds the stability bound of the {} integrator, set by the {} contact "
+                            "of the smallest particle (d = {:.3g} m)",
+                            ts.dt, c.integrator == engine::Integrator::newmark_explicit ? "Newmark explicit" : "velocity Verlet",
+                            ts.limiting, dmin),
+                fmt::format("dt_s <= {:.4g}", ts.bound));
+  return ts;
+}
+
+}  // namespace nipdem::experiments

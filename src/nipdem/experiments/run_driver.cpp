@@ -1,0 +1,145 @@
+#include "nipdem/experiments/run_driver.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/progress.hpp"
+#include "nipdem/io/vtk.hpp"
+#include "nipdem/version.hpp"
+
+namespace nipdem::experiments {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+const char* exit_name(Exit e) { return e == Exit::developed ? "developed" : e == Exit::returned ? "returned" : "lost"; }
+
+std::string removals_csv(const NipRun& run) {
+  std::string s = "time_s,exit,x_m,y_m,diameter_m,body_id\n";
+  for (const auto& e : run.removals())
+    s += fmt::format("{:.9g},{},{:.9g},{:.9g},{:.6g},{}\n", e.time, exit_name(e.where), e.x, e.y, e.size, e.id);
+  return s;
+}
+}  // namespace
+
+json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
+  fs::create_directories(out);
+  const fs::path ckpt = out / "checkpoint.bin";
+  if (opt.resume) {
+    if (!fs::exists(ckpt)) throw InputError(ckpt.string() + ": no checkpoint to resume from");
+  } else if (!opt.force && (fs::exists(out / "summary.json") || fs::exists(ckpt) || fs::exists(out / "particles.pvd"))) {
+    throw InputError(out.string() + ": already holds results of a run; use --resume to continue it, --force to overwrite, or another --out");
+  }
+  NipRun run(cfg);
+  std::vector<std::pair<double, std::string>> frames;
+  std::string series = "time_s,bodies,discs,inserted,developed,returned,lost,contacts,kinetic_energy_J\n";
+  if (opt.resume) {
+    run.restore(io::read_file(ckpt));
+    if (fs::exists(out / "frames.json")) {
+      for (auto& f : json::parse(io::read_file(out / "frames.json"))) frames.emplace_back(f[0].get<double>(), f[1].get<std::string>());
+    }
+    if (fs::exists(out / "timeseries.csv")) series = io::read_file(out / "timeseries.csv");
+    // drop snapshots written after the checkpoint (they will be written again)
+    while (!frames.empty() && frames.back().first > run.sim().time() + 1e-15) frames.pop_back();
+    std::string kept;
+    std::size_t pos = 0;
+    int line = 0;
+    while (pos < series.size()) {
+      const auto nl = series.find('\n', pos);
+      const std::string row = series.substr(pos, nl - pos + 1);
+      if (line++ == 0 || std::stod(row.substr(0, row.find(','))) <= run.sim().time() + 1e-15) kept += row;
+      pos = nl == std::string::npos ? series.size() : nl + 1;
+    }
+    series = kept;
+  }
+  io::write_file_atomic(out / "config.toml", cfg.resolved_toml);
+
+  const double dt = run.time_step().dt;
+  auto snapshot = [&] {
+    auto& sim = run.sim();
+    if (cfg.vtk) {
+      const int idx = static_cast<int>(frames.size());
+      frames.emplace_back(sim.time(), io::write_vtp(out, idx, sim));
+      io::write_pvd(out, frames);
+      json fj = json::array();
+      for (auto& [t, f] : frames) fj.push_back({t, f});
+      io::write_file_atomic(out / "frames.json", fj.dump());
+    }
+    series += fmt::format("{:.9g},{},{},{},{},{},{},{},{:.6g}\n", sim.time(), sim.bodies().x.size(), sim.discs().x.size(), run.inserted(),
+                          run.removed(Exit::developed), run.removed(Exit::returned), run.removed(Exit::lost), sim.contacts(),
+                          sim.energy().kinetic);
+    io::write_file_atomic(out / "timeseries.csv", series);
+  };
+  auto save_checkpoint = [&] {
+    io::write_file_atomic(ckpt, run.checkpoint());
+    io::write_file_atomic(out / "removals.csv", removals_csv(run));
+  };
+
+  const std::int64_t step0 = run.sim().step_count();
+  std::int64_t disc_steps = 0;
+  io::Progress progress("nipdem run", run.sim().time(), cfg.end_time, step0);
+  if (!opt.resume) {
+    run.sim().compute_forces();
+    snapshot();
+  }
+  auto next_multiple = [&](double interval) {
+    return (std::floor(run.sim().time() / interval + 1e-9) + 1.0) * interval;
+  };
+  double next_out = next_multiple(cfg.output_interval);
+  double next_ck = next_multiple(cfg.checkpoint_interval);
+  while (run.sim().time() < cfg.end_time - 0.5 * dt) {
+    const double target = std::min({next_out, next_ck, cfg.end_time});
+    run.advance_to(target, [&] {
+      disc_steps += static_cast<std::int64_t>(run.sim().discs().x.size()) * cfg.insert_interval;
+      if (opt.progress)
+        progress.update(run.sim().time(), run.sim().step_count(),
+                        fmt::format("particles {}  developed {}  returned {}", run.sim().bodies().x.size(),
+                                    run.removed(Exit::developed), run.removed(Exit::returned)));
+    });
+    if (run.sim().time() >= next_out - 0.5 * dt) { snapshot(); next_out = next_multiple(cfg.output_interval); }
+    if (run.sim().time() >= next_ck - 0.5 * dt) { save_checkpoint(); next_ck = next_multiple(cfg.checkpoint_interval); }
+  }
+  save_checkpoint();
+  const double wall = progress.elapsed_s();
+  const std::int64_t steps = run.sim().step_count() - step0;
+  if (opt.progress) progress.finish(run.sim().time(), run.sim().step_count());
+  const double sim_ms = static_cast<double>(steps) * dt * 1e3;
+  json coll = json::object();
+  for (const auto& r : collision_report(cfg))
+    coll[r.name] = {{"k_N_per_m", r.k}, {"gamma_Ns_per_m", r.gamma}, {"ks_N_per_m", r.ks}, {"restitution", r.restitution},
+                    {"contact_time_s", r.contact_time}, {"dt_max_s", r.dt_max_newmark}};
+  json summary = {
+      {"nipdem_version", kVersion},
+      {"git_hash", kGitHash},
+      {"config_file", cfg.file},
+      {"seed", cfg.seed},
+      {"time_s", run.sim().time()},
+      {"steps", run.sim().step_count()},
+      {"dt_s", dt},
+      {"dt_bound_s", run.time_step().bound},
+      {"dt_limited_by", run.time_step().limiting},
+      {"integrator", cfg.integrator == engine::Integrator::velocity_verlet ? "velocity_verlet" : "newmark_explicit"},
+      {"threads", cfg.threads},
+      {"particles_in_window", run.sim().bodies().x.size()},
+      {"discs_in_window", run.sim().discs().x.size()},
+      {"inserted", run.inserted()},
+      {"developed", run.removed(Exit::developed)},
+      {"returned", run.removed(Exit::returned)},
+      {"lost", run.removed(Exit::lost)},
+      {"wall_time_s", wall},
+      {"steps_this_session", steps},
+      {"disc_steps_per_s", wall > 0 ? disc_steps / wall : 0.0},
+      {"wall_s_per_simulated_ms", sim_ms > 0 ? wall / sim_ms : 0.0},
+      {"collision", coll},
+      {"geometry", run.describe()},
+      {"frames", frames.size()},
+      {"resumed", opt.resume},
+  };
+  io::write_file_atomic(out / "summary.json", summary.dump(2));
+  return summary;
+}
+
+}  // namespace nipdem::experiments
