@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <set>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 
@@ -109,12 +111,16 @@ TEST(ConductionPath, IncrementalEqualsFull) {
       c[idx] = c.back();
       c.pop_back();
     }
-    // add a few between nearby ids
+    // add a few between nearby ids (no duplicate pairs: update() rejects them)
+    std::set<std::pair<int, int>> have;
+    for (const auto& e : c) have.insert({std::min(e.i, e.j), std::max(e.i, e.j)});
     for (int k = 0; k < 10; ++k) {
       const int a = static_cast<int>(rng.uniform() * n);
       const int b = std::clamp(a + (rng.uniform() < 0.5 ? 1 : 40), 0, n - 1);
-      if (a != b) c.push_back({a, b, rng.uniform(0.5, 1.5)});
+      if (a != b && have.insert({a, b}).second) c.push_back({a, b, rng.uniform(0.5, 1.5)});
     }
+    // change one resistance
+    if (!c.empty()) c[static_cast<std::size_t>(rng.uniform() * c.size())].resistance_ohm *= 1.7;
     if (step % 17 == 0 && !r.empty()) r.pop_back();
     cp.update(c, r);
     std::vector<double> R;
@@ -129,8 +135,10 @@ TEST(ConductionPath, IncrementalEqualsFull) {
       }
     }
   }
-  std::printf("[ConductionPath] 200 edit steps: %llu incremental, %llu full recomputes\n",
-              static_cast<unsigned long long>(cp.stats().incremental), static_cast<unsigned long long>(cp.stats().full));
+  std::printf("[ConductionPath] 200 edit steps: %llu incremental, %llu full recomputes, %llu particles re-seeded\n",
+              static_cast<unsigned long long>(cp.stats().incremental), static_cast<unsigned long long>(cp.stats().full),
+              static_cast<unsigned long long>(cp.stats().invalidated));
+  EXPECT_THROW(cp.update({{0, 1, 1.0}, {1, 0, 2.0}}, r), InputError);  // duplicate pair
 }
 
 // Cost for 10^4 particles (~2.3e4 contacts): full Dijkstra, unchanged update, and an update
@@ -155,23 +163,49 @@ TEST(ConductionPath, Cost10k) {
   for (int k = 0; k < reps; ++k) cp.update(c, r);
   const double t_same = std::chrono::duration<double>(clk::now() - t0).count() / reps;
   double t_inc = 0;
+  std::set<std::pair<int, int>> have;
+  for (const auto& e : c) have.insert({std::min(e.i, e.j), std::max(e.i, e.j)});
   for (int k = 0; k < reps; ++k) {
-    for (int m = 0; m < static_cast<int>(c.size()) / 200; ++m) {
+    for (int m = 0; m < static_cast<int>(c.size()) / 200; ++m) {  // 0.5 % removed, 0.5 % added
       const std::size_t idx = static_cast<std::size_t>(rng.uniform() * c.size());
+      have.erase({std::min(c[idx].i, c[idx].j), std::max(c[idx].i, c[idx].j)});
       c[idx] = c.back();
       c.pop_back();
       const int a = static_cast<int>(rng.uniform() * (n - 1));
-      c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
+      if (have.insert({a, a + 1}).second) c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
     }
     t0 = clk::now();
     cp.update(c, r);
     t_inc += std::chrono::duration<double>(clk::now() - t0).count();
   }
   t_inc /= reps;
+  // A typical DEM step changes only a few contacts: 5 removed + 5 added.
+  double t_few = 0;
+  const int reps_few = 200;
+  for (int k = 0; k < reps_few; ++k) {
+    for (int m = 0; m < 5; ++m) {
+      const std::size_t idx = static_cast<std::size_t>(rng.uniform() * c.size());
+      have.erase({std::min(c[idx].i, c[idx].j), std::max(c[idx].i, c[idx].j)});
+      c[idx] = c.back();
+      c.pop_back();
+      const int a = static_cast<int>(rng.uniform() * (n - 1));
+      if (have.insert({a, a + 1}).second) c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
+    }
+    t0 = clk::now();
+    cp.update(c, r);
+    t_few += std::chrono::duration<double>(clk::now() - t0).count();
+  }
+  std::printf("[ConductionPath] n=1e4: update with 10 contact changes %.3f ms\n", 1e3 * t_few / reps_few);
+  std::vector<double> Rref;
+  shortest_paths(n, c, r, Rref, par, hops);
+  for (int i = 0; i < n; ++i)
+    if (!std::isinf(Rref[i])) {
+      ASSERT_NEAR(cp.path_resistance(i), Rref[i], 1e-12 * Rref[i]);
+    }
   std::printf("[ConductionPath] n=1e4, %zu contacts: full Dijkstra %.3f ms, unchanged update %.3f ms, "
-              "1%% changed update %.3f ms (%llu full, %llu incremental)\n",
+              "1%% changed update %.3f ms (%llu full, %llu incremental, %.0f re-seeded per update)\n",
               c.size(), 1e3 * t_full, 1e3 * t_same, 1e3 * t_inc, static_cast<unsigned long long>(cp.stats().full),
-              static_cast<unsigned long long>(cp.stats().incremental));
+              static_cast<unsigned long long>(cp.stats().incremental), static_cast<double>(cp.stats().invalidated) / reps);
   EXPECT_LT(t_full, 0.05);
 }
 

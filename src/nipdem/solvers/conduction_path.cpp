@@ -79,78 +79,59 @@ ConductionPaths::ConductionPaths(int num_particles) { resize(num_particles); }
 void ConductionPaths::resize(int num_particles) {
   if (num_particles < 0) throw_input(kWhere, "num_particles", std::to_string(num_particles), "must be >= 0");
   n_ = num_particles;
-  edges_.clear();
   adj_.assign(static_cast<std::size_t>(n_) + 1, {});
   dist_.assign(n_, kInf);
   parent_.assign(n_, kNoPath);
   hops_.assign(n_, -1);
+  mark_.assign(n_, 0);
 }
 
-std::vector<ConductionPaths::Edge> ConductionPaths::canonical(const std::vector<Contact>& c,
-                                                              const std::vector<RollerContact>& r) const {
-  std::vector<Edge> e;
-  e.reserve(c.size() + r.size());
-  for (const auto& x : c) {
-    check_contact(n_, x.i, x.j, x.resistance_ohm);
-    e.push_back({std::min(x.i, x.j), std::max(x.i, x.j), x.resistance_ohm});
-  }
-  for (const auto& x : r) {
-    if (x.i < 0 || x.i >= n_) throw_input(kWhere, "roller contact particle id", std::to_string(x.i), "out of range", fmt::format("[0, {})", n_));
-    require_positive(kWhere, "roller contact resistance_ohm", x.resistance_ohm);
-    e.push_back({x.i, n_, x.resistance_ohm});
-  }
-  std::sort(e.begin(), e.end(), [](const Edge& a, const Edge& b) {
-    return a.a != b.a ? a.a < b.a : (a.b != b.b ? a.b < b.b : a.r < b.r);
-  });
-  // Keep the smallest resistance of duplicate pairs.
-  e.erase(std::unique(e.begin(), e.end(), [](const Edge& a, const Edge& b) { return a.a == b.a && a.b == b.b; }), e.end());
-  return e;
+ConductionPaths::Adj* ConductionPaths::find(int u, int v) {
+  for (auto& e : adj_[u])
+    if (e.v == v) return &e;
+  return nullptr;
 }
 
-void ConductionPaths::add_adj(const Edge& e) {
-  adj_[e.a].push_back({e.b, e.r});
-  adj_[e.b].push_back({e.a, e.r});
+void ConductionPaths::erase(int u, int v) {
+  auto& l = adj_[u];
+  for (std::size_t k = 0; k < l.size(); ++k)
+    if (l[k].v == v) {
+      l[k] = l.back();
+      l.pop_back();
+      return;
+    }
 }
 
-void ConductionPaths::remove_adj(const Edge& e) {
-  auto drop = [](std::vector<std::pair<int, double>>& v, int other, double r) {
-    for (std::size_t k = 0; k < v.size(); ++k)
-      if (v[k].first == other && v[k].second == r) {
-        v[k] = v.back();
-        v.pop_back();
-        return;
-      }
-  };
-  drop(adj_[e.a], e.b, e.r);
-  drop(adj_[e.b], e.a, e.r);
-}
+void ConductionPaths::recompute_all() { full_recompute(); }
 
 void ConductionPaths::full_recompute() {
   std::fill(dist_.begin(), dist_.end(), kInf);
   std::fill(parent_.begin(), parent_.end(), kNoPath);
   std::fill(hops_.begin(), hops_.end(), -1);
   std::vector<int> seeds{n_};
-  relax_from(seeds);
+  relax(seeds);
 }
 
-// Dijkstra started from the given nodes with their current distances (the roller, node n_,
-// has distance 0). Only improvements propagate, so this is exact after edge insertions.
-void ConductionPaths::relax_from(std::vector<int>& seeds) {
+// Label-correcting Dijkstra from the seeds with their current labels (the roller, node n_,
+// has label 0). Labels only decrease, and every particle whose label may be too large is a
+// seed or reachable from one, so the result is the exact shortest-path forest.
+void ConductionPaths::relax(std::vector<int>& seeds) {
   MinQueue q;
   auto dist = [&](int u) { return u == n_ ? 0.0 : dist_[u]; };
-  for (int s : seeds) q.push({dist(s), s});
+  for (int s : seeds)
+    if (dist(s) < kInf) q.push({dist(s), s});
   while (!q.empty()) {
     const auto [d, u] = q.top();
     q.pop();
     if (d > dist(u)) continue;
-    for (const auto& [v, r] : adj_[u]) {
-      if (v == n_) continue;
-      const double nd = d + r;
-      if (nd < dist_[v]) {
-        dist_[v] = nd;
-        parent_[v] = (u == n_) ? kRoller : u;
-        hops_[v] = (u == n_) ? 0 : hops_[u] + 1;
-        q.push({nd, v});
+    for (const Adj& e : adj_[u]) {
+      if (e.v == n_) continue;
+      const double nd = d + e.r;
+      if (nd < dist_[e.v]) {
+        dist_[e.v] = nd;
+        parent_[e.v] = (u == n_) ? kRoller : u;
+        hops_[e.v] = (u == n_) ? 0 : hops_[u] + 1;
+        q.push({nd, e.v});
       }
     }
   }
@@ -158,43 +139,105 @@ void ConductionPaths::relax_from(std::vector<int>& seeds) {
 
 bool ConductionPaths::update(const std::vector<Contact>& contacts, const std::vector<RollerContact>& roller) {
   ++stats_.updates;
-  std::vector<Edge> e = canonical(contacts, roller);
-  if (e == edges_) {
+  const std::uint64_t stamp = ++round_;
+  std::vector<Edge> added, removed;
+  auto visit = [&](int a, int b, double r) {
+    if (Adj* e = find(a, b)) {
+      if (e->stamp == stamp)
+        throw_input(kWhere, "contact", b == n_ ? fmt::format("(particle {}, roller)", a) : fmt::format("({}, {})", a, b),
+                    "listed twice in one update");
+      e->stamp = stamp;
+      if (e->r != r) {
+        removed.push_back({a, b, e->r});
+        added.push_back({a, b, r});
+        e->r = r;
+        find(b, a)->r = r;
+      }
+    } else {
+      adj_[a].push_back({b, r, stamp});
+      adj_[b].push_back({a, r, stamp});
+      added.push_back({a, b, r});
+    }
+  };
+  for (const auto& c : contacts) {
+    check_contact(n_, c.i, c.j, c.resistance_ohm);
+    visit(std::min(c.i, c.j), std::max(c.i, c.j), c.resistance_ohm);
+  }
+  for (const auto& rc : roller) {
+    if (rc.i < 0 || rc.i >= n_)
+      throw_input(kWhere, "roller contact particle id", std::to_string(rc.i), "out of range", fmt::format("[0, {})", n_));
+    require_positive(kWhere, "roller contact resistance_ohm", rc.resistance_ohm);
+    visit(rc.i, n_, rc.resistance_ohm);
+  }
+  // Contacts not listed this round are gone (each edge checked from its smaller end).
+  std::vector<Edge> gone;
+  for (int u = 0; u < n_; ++u)
+    for (const Adj& e : adj_[u])
+      if (e.v > u && e.stamp != stamp) gone.push_back({u, e.v, e.r});
+  for (const Edge& e : gone) {
+    erase(e.a, e.b);
+    erase(e.b, e.a);
+  }
+  removed.insert(removed.end(), gone.begin(), gone.end());
+  if (added.empty() && removed.empty()) {
     ++stats_.unchanged;
     return false;
   }
-  // Merge-diff the sorted lists.
-  std::vector<Edge> added, removed;
-  std::size_t a = 0, b = 0;
-  while (a < edges_.size() || b < e.size()) {
-    if (b == e.size() || (a < edges_.size() && edges_[a] < e[b])) removed.push_back(edges_[a++]);
-    else if (a == edges_.size() || e[b] < edges_[a]) added.push_back(e[b++]);
-    else {
-      if (!(edges_[a].r == e[b].r)) { removed.push_back(edges_[a]); added.push_back(e[b]); }
-      ++a; ++b;
+  // Roots of invalidated subtrees: the child end of every removed tree edge.
+  std::vector<int> stack;
+  for (const Edge& e : removed) {
+    if (e.b == n_) {
+      if (parent_[e.a] == kRoller && dist_[e.a] == e.r) stack.push_back(e.a);
+    } else {
+      if (parent_[e.b] == e.a) stack.push_back(e.b);
+      if (parent_[e.a] == e.b) stack.push_back(e.a);
     }
   }
-  // A removed edge matters only if it is a shortest-path-tree edge.
-  bool tree_hit = false;
-  for (const Edge& x : removed) {
-    remove_adj(x);
-    if (x.b == n_) tree_hit |= parent_[x.a] == kRoller && dist_[x.a] == x.r;
-    else tree_hit |= parent_[x.b] == x.a || parent_[x.a] == x.b;
+  std::vector<int> invalid;
+  for (int r : stack) mark_[r] = 1;
+  while (!stack.empty()) {
+    const int u = stack.back();
+    stack.pop_back();
+    invalid.push_back(u);
+    for (const Adj& e : adj_[u])
+      if (e.v != n_ && !mark_[e.v] && parent_[e.v] == u) {
+        mark_[e.v] = 1;
+        stack.push_back(e.v);
+      }
   }
-  for (const Edge& x : added) add_adj(x);
-  edges_ = std::move(e);
-  if (tree_hit) {
+  stats_.invalidated += invalid.size();
+  if (invalid.size() * 2 > static_cast<std::size_t>(n_)) {
+    for (int u : invalid) mark_[u] = 0;
     ++stats_.full;
     full_recompute();
-  } else {
-    ++stats_.incremental;
-    std::vector<int> seeds;
-    for (const Edge& x : added) {
-      seeds.push_back(x.a);
-      seeds.push_back(x.b);
-    }
-    relax_from(seeds);
+    return true;
   }
+  ++stats_.incremental;
+  for (int u : invalid) {
+    dist_[u] = kInf;
+    parent_[u] = kNoPath;
+    hops_[u] = -1;
+  }
+  // Re-seed invalidated particles from their valid neighbours (and the roller).
+  std::vector<int> seeds;
+  for (int u : invalid) {
+    for (const Adj& e : adj_[u]) {
+      if (e.v == n_) {
+        if (e.r < dist_[u]) { dist_[u] = e.r; parent_[u] = kRoller; hops_[u] = 0; }
+      } else if (!mark_[e.v] && dist_[e.v] + e.r < dist_[u]) {
+        dist_[u] = dist_[e.v] + e.r;
+        parent_[u] = e.v;
+        hops_[u] = hops_[e.v] + 1;
+      }
+    }
+    seeds.push_back(u);
+  }
+  for (int u : invalid) mark_[u] = 0;
+  for (const Edge& e : added) {
+    seeds.push_back(e.a);
+    seeds.push_back(e.b);
+  }
+  relax(seeds);
   return true;
 }
 
