@@ -6,6 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "nipdem/experiments/calibrate_rc.hpp"
+#include "nipdem/io/print_pattern.hpp"
+#include "nipdem/core/error.hpp"
+#include "nipdem/models/rc_charge.hpp"
 #include "nipdem/models/probe_circuit.hpp"
 #include "registry.hpp"
 
@@ -18,6 +21,14 @@ struct ResponseOpts {
   double voltage = 40.0;
   std::string freq;
   bool json = false;
+};
+
+struct ChargeOpts {
+  std::string pattern;
+  double R = 5.9e11, Rd = 1.8e24, C = 3.9e-16;
+  double drum_speed = 6.7 / 60.0;
+  double dt = 1e-5, t_end = 0.0;
+  bool contact = false, json = false;
 };
 
 struct CalOpts {
@@ -58,6 +69,61 @@ nipdem::cli::Register reg([](CLI::App& app) {
       j["C_F"] = o->p.C_F;
       j["Rm_ohm"] = o->p.Rm_ohm;
       j["voltage_V"] = o->voltage;
+      nipdem::cli::print_json(j.dump());
+    }
+  });
+
+  auto* ch = rc->add_subcommand("charge",
+                                 "Capacitor voltage of one particle charged through a path R under a print pattern (§2.5.5)");
+  auto q = std::make_shared<ChargeOpts>();
+  ch->add_option("--pattern", q->pattern, "TOML file with a [print] table (see docs/charge-model.md)")->required();
+  ch->add_option("--R", q->R, "path resistance [ohm]")->capture_default_str();
+  ch->add_option("--Rd", q->Rd, "toner-drum leak resistance when touching [ohm]")->capture_default_str();
+  ch->add_option("--C", q->C, "toner-drum capacity [F]")->capture_default_str();
+  ch->add_option("--drum-speed", q->drum_speed, "drum surface speed [m/s] (CPS700: 6.7 m/min)")->capture_default_str();
+  ch->add_option("--dt", q->dt, "output interval [s]")->capture_default_str();
+  ch->add_option("--t-end", q->t_end, "end time [s] (default: 1.2 x the end of the last line)");
+  ch->add_flag("--contact", q->contact, "particle touches the drum (leak through Rd)");
+  ch->add_flag("--json", q->json, "print one JSON object on stdout");
+  ch->callback([q] {
+    using namespace nipdem;
+    const io::PrintPattern pat = io::load_print_pattern(q->pattern);
+    require_positive("rc charge", "--drum-speed", q->drum_speed);
+    require_positive("rc charge", "--dt", q->dt);
+    charge::RcChargeParams p;
+    p.C_td_F = q->C;
+    p.R_td_ohm = q->Rd;
+    p.validate();
+    require_positive("rc charge", "--R", q->R);
+    double t_end = q->t_end;
+    if (t_end <= 0.0) {
+      const double s_end = pat.segments().empty() ? 0.0 : pat.segments().back().end_m;
+      t_end = 1.2 * std::max(s_end, 0.0) / q->drum_speed;
+      if (t_end <= 0.0) t_end = 10 * q->R * q->C;
+    }
+    if (t_end / q->dt > 1e6) throw_input("rc charge", "--dt", std::to_string(q->dt), "more than 1e6 output rows", ">= t_end/1e6");
+    const auto coupling = q->contact ? charge::DrumCoupling::contact : charge::DrumCoupling::capacitor;
+    nlohmann::json rows = nlohmann::json::array();
+    double u = 0.0, t = 0.0;
+    if (!q->json) std::printf("%14s %16s %14s\n", "time_s", "drum_voltage_V", "voltage_V");
+    // Integrate exactly between pattern switching points (the drum voltage is piecewise constant).
+    for (long k = 0; t <= t_end * (1 + 1e-12); ++k) {
+      const double Vd = pat.voltage_at_time(t, q->drum_speed);
+      if (q->json) rows.push_back({{"time_s", t}, {"drum_voltage_V", Vd}, {"voltage_V", u}});
+      else std::printf("%14.6e %16.6g %14.6f\n", t, Vd, u);
+      const double t_next = (k + 1) * q->dt;
+      while (t < t_next) {
+        const double s_sw = pat.next_switch_after(q->drum_speed * t) / q->drum_speed;
+        const double t_stop = std::min(t_next, s_sw);
+        u = charge::rc_update(u, pat.voltage_at_time(t, q->drum_speed), q->R, coupling, p, t_stop - t);
+        t = t_stop;
+      }
+    }
+    if (q->json) {
+      nlohmann::json j;
+      j["rows"] = rows;
+      j["tau_s"] = charge::rc_time_constant(q->R, coupling, p);
+      j["drum_speed_m_per_s"] = q->drum_speed;
       nipdem::cli::print_json(j.dump());
     }
   });
