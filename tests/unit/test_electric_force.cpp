@@ -110,6 +110,39 @@ TEST(ElectricForce, ThesisSeriesMisprintAndCorrection) {
   }
 }
 
+// Locating the misprint: a direct quadrature of eq. 2.5.32 (with V1, V2 of eq. 2.5.30) gives
+// the same value as the closed forms 2.5.40/2.5.41, so those are faithful and the factor
+// -2 comes from eqs. 2.5.24/2.5.28 (missing 1/2 of the Maxwell stress, x-component sign).
+// Gauss–Legendre would be nicer; the midpoint rule with 20000 panels on a smooth integrand
+// (d >= 0.3R) is accurate to ~1e-8; tolerance 1e-6.
+TEST(ElectricForce, ThesisIntegralEqualsItsClosedForm) {
+  for (double x : {0.3, 1.0, 3.0}) {
+    const double d = x * kR;
+    const double eta = std::acosh(1.0 + x), c = std::cosh(eta);
+    const double V1 = std::sinh(eta) / (2.0 * std::sqrt(2.0));
+    const int nmax = static_cast<int>(40.0 / eta) + 10, N = 20000;
+    double sum = 0.0;
+    for (int i = 0; i < N; ++i) {
+      const double t = -1.0 + (i + 0.5) * 2.0 / N;
+      double p0 = 1.0, p1 = t, series = 0.0;
+      for (int n = 0; n <= nmax; ++n) {
+        double Pn = n == 0 ? 1.0 : t;
+        if (n >= 2) {
+          Pn = ((2 * n - 1) * t * p1 - (n - 1) * p0) / n;
+          p0 = p1;
+          p1 = Pn;
+        }
+        const double m = n + 0.5;
+        series += m / std::tanh(m * eta) * std::exp(-m * eta) * Pn;  // v_n P_n, eq. 2.5.36
+      }
+      const double V2 = std::pow(c - t, 1.5) * series;
+      sum += (t * c - 1.0) / std::pow(c - t, 3) * (V1 + V2) * (V1 + V2) * (2.0 / N);
+    }
+    const double F_integral = 4.0 * constants::pi * constants::eps0 * kV * kV * sum;  // eq. 2.5.31/2.5.32
+    EXPECT_NEAR(F_integral / force_series_as_printed(kR, kV, d), 1.0, 1e-6) << "d/R = " << x;
+  }
+}
+
 // Eq. 2.5.42 with a = 0.45 is 1.8 x the small-gap limit (0.45 * 4 = 1.8 vs 1). Its ratio to
 // the exact force grows monotonically with d: measured 1.805 at 0.001R, 1.837 at 0.01R,
 // 2.06 at 0.1R, 3.73 at R (table in docs/electric.md). We check the documented range
