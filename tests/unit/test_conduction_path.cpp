@@ -209,6 +209,19 @@ TEST(ConductionPath, Cost10k) {
   EXPECT_LT(t_full, 0.05);
 }
 
+// Hop statistics for the per-contact calibration: a chain of 12 plus one isolated particle.
+TEST(ConductionPath, HopStatistics) {
+  std::vector<Contact> c;
+  for (int i = 0; i < 12; ++i) c.push_back({i, i + 1, 1.0});
+  ConductionPaths cp(14);
+  cp.update(c, {{0, 1.0}});
+  const auto h = hop_statistics(cp, {4, 12, 13});
+  EXPECT_EQ(h.count, 3);
+  EXPECT_DOUBLE_EQ(h.mean_hops, 8.0);  // (4 + 12) / 2
+  EXPECT_DOUBLE_EQ(h.connected_fraction, 2.0 / 3.0);
+  EXPECT_THROW(hop_statistics(cp, {14}), InputError);
+}
+
 TEST(ConductionPath, BadInput) {
   ConductionPaths cp(3);
   EXPECT_THROW(cp.update({{0, 3, 1.0}}, {}), InputError);

@@ -248,4 +248,22 @@ std::vector<int> ConductionPaths::path(int i) const {
   return p;
 }
 
+HopStats hop_statistics(const ConductionPaths& paths, const std::vector<int>& ids) {
+  HopStats h;
+  long sum = 0;
+  int connected = 0;
+  for (int i : ids) {
+    if (i < 0 || i >= paths.size())
+      throw_input(kWhere, "particle id", std::to_string(i), "out of range", fmt::format("[0, {})", paths.size()));
+    ++h.count;
+    if (paths.connected(i)) {
+      ++connected;
+      sum += paths.hops(i);
+    }
+  }
+  h.mean_hops = connected ? static_cast<double>(sum) / connected : 0.0;
+  h.connected_fraction = h.count ? static_cast<double>(connected) / h.count : 0.0;
+  return h;
+}
+
 }  // namespace nipdem::conduction

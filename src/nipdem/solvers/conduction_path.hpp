@@ -95,4 +95,14 @@ class ConductionPaths {
   Stats stats_;
 };
 
+// Mean number of toner–toner contacts on the shortest paths of the connected particles among
+// `ids` (e.g. the particles touching the drum), and the fraction of them that is connected.
+// With uniform R_tt this is the <k> of charge::calibrate_contacts (docs/charge-model.md).
+struct HopStats {
+  double mean_hops = 0.0;
+  double connected_fraction = 0.0;
+  int count = 0;
+};
+HopStats hop_statistics(const ConductionPaths& paths, const std::vector<int>& ids);
+
 }  // namespace nipdem::conduction
