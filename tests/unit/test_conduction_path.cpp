@@ -94,6 +94,23 @@ TEST(ConductionPath, MatchesBellmanFord) {
   }
 }
 
+// The CSR entry point gives the same result as the edge-list one (it is what the latter calls,
+// but the test also checks the size validation).
+TEST(ConductionPath, CsrInput) {
+  // roller - 0 - 1 - 2, and 0 - 2 directly with a large resistance
+  const std::vector<int> off{0, 2, 4, 6};
+  const std::vector<int> nb{1, 2, 0, 2, 1, 0};
+  const std::vector<double> w{1.0, 5.0, 1.0, 1.0, 1.0, 5.0};
+  std::vector<double> R;
+  std::vector<int> par, hops;
+  shortest_paths_csr(3, off, nb, w, {{0, 0.5}}, R, par, hops);
+  EXPECT_DOUBLE_EQ(R[2], 2.5);
+  EXPECT_EQ(par[2], 1);
+  EXPECT_EQ(hops[2], 2);
+  EXPECT_THROW(shortest_paths_csr(3, {0, 2, 4}, nb, w, {}, R, par, hops), InputError);
+  EXPECT_THROW(shortest_paths_csr(3, off, nb, {1.0, 5.0, 1.0, 1.0, 1.0, -5.0}, {}, R, par, hops), InputError);
+}
+
 // Incremental updates (random insertions/removals of ~2 % of the contacts per step) must give
 // the same path resistances as a full recompute after every step (1e-12 relative).
 TEST(ConductionPath, IncrementalEqualsFull) {

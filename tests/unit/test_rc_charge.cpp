@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/models/rc_charge.hpp"
@@ -98,6 +99,20 @@ TEST(RcCharge, ContactCalibrationReproducesR) {
   const auto b = RcChargeParams::black();
   EXPECT_NEAR(chain_resistance(15, b) * b.C_td_F, 5.9e11 * 3.9e-16, 1e-18);  // RC = 0.23 ms
   EXPECT_NO_THROW(b.validate());
+}
+
+// The batch form equals the scalar one element by element.
+TEST(RcCharge, BatchEqualsScalar) {
+  const auto p = RcChargeParams::black();
+  std::vector<double> u{0.0, 10.0, 20.0, 5.0};
+  const std::vector<double> R{5.9e11, kNoPath, 1e11, 3e11};
+  const std::vector<DrumCoupling> c{DrumCoupling::capacitor, DrumCoupling::capacitor, DrumCoupling::none, DrumCoupling::contact};
+  std::vector<double> ref = u;
+  for (std::size_t i = 0; i < u.size(); ++i) ref[i] = rc_update(u[i], 40.0, R[i], c[i], p, 1e-4);
+  rc_update_all(u, R, c, 40.0, p, 1e-4);
+  EXPECT_EQ(u, ref);
+  std::vector<double> shorter{1.0};
+  EXPECT_THROW(rc_update_all(shorter, R, c, 40.0, p, 1e-4), InputError);
 }
 
 TEST(RcCharge, BadValues) {

@@ -61,6 +61,14 @@ double rc_update(double u, double V_drum, double R_path, DrumCoupling coupling, 
   return u_inf + (u - u_inf) * std::exp(-dt / tau);
 }
 
+void rc_update_all(std::span<double> u, std::span<const double> R_path, std::span<const DrumCoupling> coupling,
+                   double V_drum, const RcChargeParams& p, double dt) {
+  if (R_path.size() != u.size() || coupling.size() != u.size())
+    throw_input(kWhere, "array sizes", fmt::format("u {}, R_path {}, coupling {}", u.size(), R_path.size(), coupling.size()),
+                "must be equal");
+  for (std::size_t i = 0; i < u.size(); ++i) u[i] = rc_update(u[i], V_drum, R_path[i], coupling[i], p, dt);
+}
+
 double chain_resistance(int k, const RcChargeParams& p) {
   if (k < 0) throw_input(kWhere, "contacts on path", std::to_string(k), "must be >= 0");
   return k * p.R_tt_ohm + p.R_ti_ohm;

@@ -20,6 +20,7 @@
 // u_inf = V_d, tau = R_path C_td.
 #pragma once
 #include <limits>
+#include <span>
 
 namespace nipdem::charge {
 
@@ -48,6 +49,11 @@ enum class DrumCoupling {
 // Exact one-step update of the capacitor voltage u [V] over dt [s] >= 0 with drum voltage
 // V_drum [V] and path resistance R_path [ohm] (kNoPath if the particle has no path).
 double rc_update(double u, double V_drum, double R_path, DrumCoupling coupling, const RcChargeParams& p, double dt);
+
+// Batch form for the engine: u[i] = rc_update(u[i], V_drum, R_path[i], coupling[i], p, dt)
+// for all i (arrays of equal length; InputError otherwise).
+void rc_update_all(std::span<double> u, std::span<const double> R_path, std::span<const DrumCoupling> coupling,
+                   double V_drum, const RcChargeParams& p, double dt);
 
 // Time constant [s] and asymptotic voltage [V] of the step above (tau = inf: frozen).
 double rc_time_constant(double R_path, DrumCoupling coupling, const RcChargeParams& p);

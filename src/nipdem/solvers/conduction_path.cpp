@@ -24,23 +24,17 @@ using QItem = std::pair<double, int>;
 using MinQueue = std::priority_queue<QItem, std::vector<QItem>, std::greater<>>;
 }  // namespace
 
-void shortest_paths(int n, const std::vector<Contact>& contacts, const std::vector<RollerContact>& roller,
-                    std::vector<double>& R_path, std::vector<int>& parent, std::vector<int>& hops) {
+void shortest_paths_csr(int n, const std::vector<int>& deg, const std::vector<int>& nb, const std::vector<double>& w,
+                        const std::vector<RollerContact>& roller, std::vector<double>& R_path, std::vector<int>& parent,
+                        std::vector<int>& hops) {
   if (n < 0) throw_input(kWhere, "num_particles", std::to_string(n), "must be >= 0");
-  // CSR adjacency of the toner–toner graph.
-  std::vector<int> deg(static_cast<std::size_t>(n) + 1, 0);
-  for (const auto& c : contacts) {
-    check_contact(n, c.i, c.j, c.resistance_ohm);
-    ++deg[c.i + 1];
-    ++deg[c.j + 1];
-  }
-  for (int i = 0; i < n; ++i) deg[i + 1] += deg[i];
-  std::vector<int> nb(deg[n]);
-  std::vector<double> w(deg[n]);
-  std::vector<int> fill(deg.begin(), deg.end() - 1);
-  for (const auto& c : contacts) {
-    nb[fill[c.i]] = c.j; w[fill[c.i]++] = c.resistance_ohm;
-    nb[fill[c.j]] = c.i; w[fill[c.j]++] = c.resistance_ohm;
+  if (deg.size() != static_cast<std::size_t>(n) + 1 || deg[0] != 0 || nb.size() != static_cast<std::size_t>(deg[n]) ||
+      w.size() != nb.size())
+    throw_input(kWhere, "CSR arrays", fmt::format("offsets {}, neighbors {}, resistances {}", deg.size(), nb.size(), w.size()),
+                "inconsistent sizes", "offsets n+1 starting at 0, neighbors and resistances offsets[n]");
+  for (int i = 0; i < n; ++i) {
+    if (deg[i + 1] < deg[i]) throw_input(kWhere, "CSR offsets", std::to_string(i), "must be non-decreasing");
+    for (int k = deg[i]; k < deg[i + 1]; ++k) check_contact(n, i, nb[k], w[k]);
   }
   R_path.assign(n, kInf);
   parent.assign(n, kNoPath);
@@ -72,6 +66,27 @@ void shortest_paths(int n, const std::vector<Contact>& contacts, const std::vect
       }
     }
   }
+}
+
+void shortest_paths(int n, const std::vector<Contact>& contacts, const std::vector<RollerContact>& roller,
+                    std::vector<double>& R_path, std::vector<int>& parent, std::vector<int>& hops) {
+  if (n < 0) throw_input(kWhere, "num_particles", std::to_string(n), "must be >= 0");
+  // CSR adjacency of the toner–toner graph.
+  std::vector<int> deg(static_cast<std::size_t>(n) + 1, 0);
+  for (const auto& c : contacts) {
+    check_contact(n, c.i, c.j, c.resistance_ohm);
+    ++deg[c.i + 1];
+    ++deg[c.j + 1];
+  }
+  for (int i = 0; i < n; ++i) deg[i + 1] += deg[i];
+  std::vector<int> nb(deg[n]);
+  std::vector<double> w(deg[n]);
+  std::vector<int> fill(deg.begin(), deg.end() - 1);
+  for (const auto& c : contacts) {
+    nb[fill[c.i]] = c.j; w[fill[c.i]++] = c.resistance_ohm;
+    nb[fill[c.j]] = c.i; w[fill[c.j]++] = c.resistance_ohm;
+  }
+  shortest_paths_csr(n, deg, nb, w, roller, R_path, parent, hops);
 }
 
 ConductionPaths::ConductionPaths(int num_particles) { resize(num_particles); }

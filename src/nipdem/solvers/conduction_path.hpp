@@ -43,6 +43,14 @@ inline constexpr int kNoPath = -2;   // parent of a particle without a conductin
 void shortest_paths(int n, const std::vector<Contact>& contacts, const std::vector<RollerContact>& roller,
                     std::vector<double>& R_path, std::vector<int>& parent, std::vector<int>& hops);
 
+// The same on a graph already in CSR form (e.g. the engine's neighbour/contact lists):
+// neighbours of particle i are neighbors[offsets[i] .. offsets[i+1]) with resistances
+// resistance_ohm[...] (each contact listed from both ends). Throws InputError on bad sizes,
+// ids or resistances.
+void shortest_paths_csr(int n, const std::vector<int>& offsets, const std::vector<int>& neighbors,
+                        const std::vector<double>& resistance_ohm, const std::vector<RollerContact>& roller,
+                        std::vector<double>& R_path, std::vector<int>& parent, std::vector<int>& hops);
+
 class ConductionPaths {
  public:
   explicit ConductionPaths(int num_particles = 0);
