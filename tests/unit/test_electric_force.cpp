@@ -80,6 +80,11 @@ TEST(ElectricForce, SmallGapAsymptote) {
   // Even very small gaps converge (about 37/alpha ~ 12000 terms at d = 1e-5 R).
   const double d = 1e-5 * kR;
   EXPECT_NEAR(force_small_gap_asymptote(kR, kV, d) / force_exact(kR, kV, d), 1.0, 1e-8);
+  // Below d = 1e-6 R force_exact switches to the asymptote; the series just above the switch
+  // must agree with it (continuity, 1e-11) so the switch is invisible.
+  const double d1 = 1.0001e-6 * kR, d0 = 0.9999e-6 * kR;
+  EXPECT_NEAR(force_small_gap_asymptote(kR, kV, d1) / force_exact(kR, kV, d1), 1.0, 1e-11);
+  EXPECT_NEAR(force_exact(kR, kV, d0) * d0 / (force_exact(kR, kV, d1) * d1), 1.0, 1e-6);
 }
 
 // Large gaps: grounded sphere, plate at V  <=>  sphere at -V, plate grounded. The sphere

@@ -39,8 +39,17 @@ void check_geometry(double R, double V, double d) {
   if (!std::isfinite(V)) throw_input(kWhere, "voltage", fmt::format("{:g}", V), "must be finite", "(-inf, inf)");
 }
 
+constexpr double kEulerGamma = 0.57721566490153286;
+constexpr double kAsymptoteBelow = 1e-6;  // two-term asymptote error < 1e-12 there (docs/electric.md)
+
 // Dimensionless exact force f(x) = F / (eps0 V^2), x = d/R.
 double exact_dimensionless(double x) {
+  if (x < kAsymptoteBelow) {
+    // The series would need ~37/sqrt(2x) > 2.6e7 terms; its small-gap expansion is exact to
+    // O(x ln x) absolute, i.e. < 1e-12 relative here.
+    const double c0 = std::log(2.0) / 3.0 + 2.0 * kEulerGamma / 3.0 - 1.0 / 9.0;
+    return constants::pi * (1.0 / x - std::log(1.0 / x) / 3.0 - c0);
+  }
   const double a = std::log1p(x + std::sqrt(x * (x + 2.0)));
   const double ga = xcothx_minus_1(a);
   double s = 0.0;
@@ -151,8 +160,7 @@ double force_small_gap_asymptote(double R, double V, double d, bool leading_only
   check_geometry(R, V, d);
   const double k = constants::pi * constants::eps0 * V * V;
   if (leading_only) return k * R / d;
-  constexpr double euler_gamma = 0.57721566490153286;
-  const double c0 = std::log(2.0) / 3.0 + 2.0 * euler_gamma / 3.0 - 1.0 / 9.0;
+  const double c0 = std::log(2.0) / 3.0 + 2.0 * kEulerGamma / 3.0 - 1.0 / 9.0;
   return k * (R / d - std::log(R / d) / 3.0 - c0);
 }
 
