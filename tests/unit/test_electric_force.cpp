@@ -188,6 +188,19 @@ TEST(ElectricForce, EffectiveGapAndBulk) {
   EXPECT_EQ(parse_force_model("series"), ForceModel::series);
 }
 
+// Independent check of the bulk force by the energy method: the toner layer on the SiOx layer
+// is a parallel-plate capacitor C(x) = eps_r eps0 A / x per particle area A = alpha R^2; at
+// fixed V the force is F = 1/2 V^2 |dC/dx| at x = d_l (central difference, 1e-8). The printed
+// eq. 2.5.10 is twice that (sigma E instead of sigma E / 2), like eq. 2.5.24.
+TEST(ElectricForce, BulkByEnergyMethod) {
+  const double alpha = 2.0 * std::sqrt(3.0), A = alpha * kR * kR, dl = 600e-9, er = 5.0;
+  auto C = [&](double x) { return er * constants::eps0 * A / x; };
+  const double h = 1e-6 * dl;
+  const double F_energy = 0.5 * kV * kV * (C(dl - h) - C(dl + h)) / (2 * h);
+  EXPECT_NEAR(force_bulk_corrected(kR, kV) / F_energy, 1.0, 1e-8);
+  EXPECT_NEAR(force_bulk(kR, kV) / F_energy, 2.0, 2e-8);
+}
+
 // The table reproduces the exact series; Hermite interpolation with O(h^4) derivatives on a
 // 0.004 log-spacing has error ~1e-10; tolerance 1e-9. Also reports the speed-up.
 TEST(ElectricForce, TableMatchesExact) {

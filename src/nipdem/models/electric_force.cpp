@@ -156,6 +156,10 @@ double force_bulk(double R, double V, double alpha, double layer_thickness, doub
   return eps_r * constants::eps0 * alpha * R * R * V * V / (layer_thickness * layer_thickness);
 }
 
+double force_bulk_corrected(double R, double V, double alpha, double layer_thickness, double eps_r) {
+  return 0.5 * force_bulk(R, V, alpha, layer_thickness, eps_r);
+}
+
 double force_small_gap_asymptote(double R, double V, double d, bool leading_only) {
   check_geometry(R, V, d);
   const double k = constants::pi * constants::eps0 * V * V;

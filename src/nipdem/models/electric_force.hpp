@@ -63,10 +63,14 @@ double force(const ElectricForceParams& p, double R, double V, double d);
 // distance l [m] >= 0 from the dielectric surface of the drum.
 double effective_gap(double l, double layer_thickness = kSiOxThickness_m, double eps_r = kSiOxPermittivity);
 
-// Eq. 2.5.10 (bulk estimate): F = eps_r eps0 alpha R^2 V^2 / d_l^2 [N]; alpha = 2 sqrt(3)
-// for a dense (hexagonal) packing, 4 for a square packing.
+// Eq. 2.5.10 (bulk estimate) as printed: F = eps_r eps0 alpha R^2 V^2 / d_l^2 [N]; alpha =
+// 2 sqrt(3) for a dense (hexagonal) packing, 4 for a square packing. Like eq. 2.5.24 it uses
+// sigma*E; the Maxwell stress on a conductor bounded by the dielectric is (1/2) sigma E, so
+// force_bulk_corrected = force_bulk / 2 (docs/electric.md).
 double force_bulk(double R, double V, double alpha = 3.4641016151377544, double layer_thickness = kSiOxThickness_m,
                   double eps_r = kSiOxPermittivity);
+double force_bulk_corrected(double R, double V, double alpha = 3.4641016151377544,
+                            double layer_thickness = kSiOxThickness_m, double eps_r = kSiOxPermittivity);
 
 // Small-gap asymptote (d << R): F = pi eps0 V^2 [R/d - ln(R/d)/3 - c0],
 // c0 = ln(2)/3 + 2 gamma/3 - 1/9 (derived in docs/electric.md). leading_only drops the
