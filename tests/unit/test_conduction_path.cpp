@@ -156,6 +156,18 @@ TEST(ConductionPath, IncrementalEqualsFull) {
               static_cast<unsigned long long>(cp.stats().incremental), static_cast<unsigned long long>(cp.stats().full),
               static_cast<unsigned long long>(cp.stats().invalidated));
   EXPECT_THROW(cp.update({{0, 1, 1.0}, {1, 0, 2.0}}, r), InputError);  // duplicate pair
+  // After the error the object is consistent again with the next valid update.
+  cp.update(c, r);
+  {
+    std::vector<double> R;
+    std::vector<int> par, hops;
+    shortest_paths(n, c, r, R, par, hops);
+    for (int i = 0; i < n; ++i) {
+      if (!std::isinf(R[i])) {
+        ASSERT_NEAR(cp.path_resistance(i), R[i], 1e-12 * R[i]);
+      }
+    }
+  }
 }
 
 // Cost for 10^4 particles (~2.3e4 contacts): full Dijkstra, unchanged update, and an update

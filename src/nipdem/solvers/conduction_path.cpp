@@ -174,15 +174,19 @@ bool ConductionPaths::update(const std::vector<Contact>& contacts, const std::ve
       added.push_back({a, b, r});
     }
   };
-  for (const auto& c : contacts) {
-    check_contact(n_, c.i, c.j, c.resistance_ohm);
-    visit(std::min(c.i, c.j), std::max(c.i, c.j), c.resistance_ohm);
-  }
+  // Validate everything before touching the graph.
+  for (const auto& c : contacts) check_contact(n_, c.i, c.j, c.resistance_ohm);
   for (const auto& rc : roller) {
     if (rc.i < 0 || rc.i >= n_)
       throw_input(kWhere, "roller contact particle id", std::to_string(rc.i), "out of range", fmt::format("[0, {})", n_));
     require_positive(kWhere, "roller contact resistance_ohm", rc.resistance_ohm);
-    visit(rc.i, n_, rc.resistance_ohm);
+  }
+  try {
+    for (const auto& c : contacts) visit(std::min(c.i, c.j), std::max(c.i, c.j), c.resistance_ohm);
+    for (const auto& rc : roller) visit(rc.i, n_, rc.resistance_ohm);
+  } catch (...) {
+    resize(n_);  // a duplicate pair was found mid-way: drop the half-applied graph (next update rebuilds it)
+    throw;
   }
   // Contacts not listed this round are gone (each edge checked from its smaller end).
   std::vector<Edge> gone;

@@ -56,8 +56,9 @@ class ConductionPaths {
   explicit ConductionPaths(int num_particles = 0);
 
   // Sets the current contacts (any order). Returns true if any contact changed, i.e. path
-  // resistances may have changed. Throws InputError for a bad id/resistance or a pair
-  // listed twice in one call.
+  // resistances may have changed. Throws InputError for a bad id/resistance (state
+  // unchanged) or a pair listed twice in one call (the graph is cleared; the next valid
+  // update rebuilds it).
   bool update(const std::vector<Contact>& contacts, const std::vector<RollerContact>& roller);
   // Changes the number of particles (ids are 0..n-1) and clears all contacts.
   void resize(int num_particles);
