@@ -1,0 +1,66 @@
+// Least-squares calibration of the probe circuit (thesis §4.7): fit R, Rd, C of
+// models/probe_circuit.hpp to measured amplitude and phase versus frequency.
+//
+// Method: Levenberg–Marquardt in p = (ln R, ln Rd, ln C). Residuals are
+//   (ln Vm_model - ln Vm_meas) / s_A   and   (phi_model - phi_meas) / s_phi,
+// i.e. a relative amplitude error and an absolute phase error. When the noise levels are
+// not given, s_A and s_phi are estimated from the residuals of a first fit (each block's
+// RMS with its share of the degrees of freedom) and the fit is repeated with those weights.
+// Uncertainties: covariance (J^T W J)^-1 at the optimum in log-parameters; the standard
+// deviation of a parameter is value * sd(ln value) (linearised). Rd is only identifiable
+// when 1/(w C) or R is not negligible next to it; for the thesis values (Rd = 1.8e24 ohm)
+// the data carry no information on Rd beyond a lower bound. Therefore a profile-likelihood
+// interval for Rd (Delta chi^2 = 3.84, 95 %) is always computed; when its upper end reaches
+// the search box (1e30 ohm) Rd is reported as not identifiable, its standard deviation as
+// infinite, and R, C uncertainties are taken from the fit with Rd fixed.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "nipdem/models/probe_circuit.hpp"
+
+namespace nipdem::probe {
+
+struct RcDataPoint {
+  double frequency_Hz = 0.0;
+  double amplitude_V = 0.0;
+  double phase_deg = 0.0;
+};
+
+// Reads a CSV with a header naming the columns frequency_Hz, amplitude_V, phase_deg (any
+// order; extra columns ignored; '#' comment lines and blank lines skipped). Throws InputError
+// naming the file, line and column for a missing column, a non-number, f <= 0, amplitude <= 0,
+// |phase| >= 90 deg, or fewer than 3 rows.
+std::vector<RcDataPoint> read_rc_csv(const std::filesystem::path& path);
+std::vector<RcDataPoint> parse_rc_csv(const std::string& text, const std::string& source);
+
+struct RcFitOptions {
+  double voltage_V = 40.0;        // applied amplitude [V]
+  double Rm_ohm = 1e4;            // measurement resistance [ohm]
+  double particles = 1.0;         // measured amplitude = particles x single-particle amplitude
+  double amplitude_rel_std = 0.0; // known relative amplitude noise [-]; 0 = estimate
+  double phase_std_deg = 0.0;     // known phase noise [deg]; 0 = estimate
+  int max_iterations = 500;
+  void validate() const;
+};
+
+struct RcFitResult {
+  double R_ohm = 0, Rd_ohm = 0, C_F = 0;
+  double R_ohm_std = 0, Rd_ohm_std = 0, C_F_std = 0;  // linearised; Rd_ohm_std = inf if not identifiable
+  double R_log_std = 0, Rd_log_std = 0, C_log_std = 0;  // sd of the natural logarithms
+  double Rd_ohm_lower_95 = 0, Rd_ohm_upper_95 = 0;     // profile-likelihood interval (upper may be inf)
+  bool Rd_identifiable = false;
+  double corr_R_C = 0;            // correlation of ln R and ln C
+  double amplitude_rel_std = 0;   // noise levels used for the weights
+  double phase_std_deg = 0;
+  double chi2 = 0;                // weighted, at the optimum
+  int dof = 0;
+  int iterations = 0;
+  bool converged = false;
+  double tau_s = 0;               // (R + Rm) C, the RC time of the circuit
+};
+
+RcFitResult fit_rc(const std::vector<RcDataPoint>& data, const RcFitOptions& opt = {});
+
+}  // namespace nipdem::probe
