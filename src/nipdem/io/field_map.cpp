@@ -112,8 +112,11 @@ FieldMap::FieldMap(double x0, double y0, double hx, double hy, int nx, int ny, s
         out[k].fxy = d1(&fy[static_cast<std::size_t>(j) * nx], nx, 1, i);
       }
   };
-  build(Bx, bx_);
-  build(By, by_);
+  std::vector<Node> bx, by;
+  build(Bx, bx);
+  build(By, by);
+  nodes_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) nodes_[k].c[0] = bx[k], nodes_[k].c[1] = by[k];
 }
 
 bool FieldMap::contains(Vec2 p) const {
@@ -136,12 +139,11 @@ magnet::Sample FieldMap::at(Vec2 p) const {
   const double Av[2] = {2 * v3 - 3 * v2 + 1, -2 * v3 + 3 * v2}, Dv[2] = {v3 - 2 * v2 + v, v3 - v2};
   const double dAv[2] = {6 * v2 - 6 * v, -6 * v2 + 6 * v}, dDv[2] = {3 * v2 - 4 * v + 1, 3 * v2 - 2 * v};
   double val[2] = {0, 0}, du[2] = {0, 0}, dv[2] = {0, 0};
-  const std::vector<Node>* comp[2] = {&bx_, &by_};
   for (int b = 0; b < 2; ++b)
     for (int a = 0; a < 2; ++a) {
       const std::size_t k = static_cast<std::size_t>(j + b) * nx_ + (i + a);
       for (int c = 0; c < 2; ++c) {
-        const Node& nd = (*comp[c])[k];
+        const Node& nd = nodes_[k].c[c];
         val[c] += nd.f * Au[a] * Av[b] + nd.fx * Du[a] * Av[b] + nd.fy * Au[a] * Dv[b] + nd.fxy * Du[a] * Dv[b];
         du[c] += nd.f * dAu[a] * Av[b] + nd.fx * dDu[a] * Av[b] + nd.fy * dAu[a] * Dv[b] + nd.fxy * dDu[a] * Dv[b];
         dv[c] += nd.f * Au[a] * dAv[b] + nd.fx * Du[a] * dAv[b] + nd.fy * Au[a] * dDv[b] + nd.fxy * Du[a] * dDv[b];

@@ -55,9 +55,12 @@ class FieldMap final : public magnet::MagnetField {
   struct Node {  // per component: value, d/dx * hx, d/dy * hy, d2/dxdy * hx * hy (scaled to the cell)
     double f, fx, fy, fxy;
   };
+  struct alignas(64) Node2 {  // both components of one node in one cache line
+    Node c[2];
+  };
   double x0_, y0_, hx_, hy_;
   int nx_, ny_;
-  std::vector<Node> bx_, by_;
+  std::vector<Node2> nodes_;
   std::string where_;
 };
 
