@@ -19,6 +19,8 @@ struct Common {
   std::string preset = "black";
   std::string map;
   double radius = 0.0;  // 0 = d50/2 of the preset toner
+  double tip_depth = -1.0;  // < 0: preset default
+  double br = -100.0;       // < -99: preset default
   bool json = false;
 };
 
@@ -33,10 +35,23 @@ Setup make_setup(const Common& c) {
   s.toner = magnet::preset_toner(c.preset);
   s.radius = c.radius == 0.0 ? magnet::preset_d50_radius(c.preset) : c.radius;
   require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  if (!c.map.empty())
+  const bool custom = c.tip_depth >= 0.0 || c.br > -99.0;
+  if (!c.map.empty()) {
+    if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
     s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
-  else
+  } else if (custom && c.preset == "black") {
+    magnet::KnifeParams k;
+    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
+    if (c.br > -99.0) k.blade_Br_T = c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
+  } else if (custom && c.preset == "color") {
+    magnet::ColorPoleParams k;
+    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
+    if (c.br > -99.0) k.Br_T = c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
+  } else {
     s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
+  }
   return s;
 }
 
@@ -44,6 +59,8 @@ void add_common(CLI::App* sub, Common& c) {
   sub->add_option("--preset", c.preset, "magnet and toner preset: black or color")->capture_default_str();
   sub->add_option("--map", c.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
   sub->add_option("--radius", c.radius, "toner radius [m] (default: d50/2 of the preset toner, Table 2.1)");
+  sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m]");
+  sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T]");
   sub->add_flag("--json", c.json, "print one JSON object on stdout");
 }
 

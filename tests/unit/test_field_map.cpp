@@ -237,6 +237,11 @@ TEST(FieldMapCli, ProbeLineAndErrorsExitCodes) {
   EXPECT_EQ(run_cli("field probe --preset magenta --x 0 --y 1e-4 --json"), 2);
   EXPECT_EQ(run_cli("field probe --preset black --x 5 --y 1e-4 --json"), 2);
   EXPECT_EQ(run_cli("field probe --preset black --x 0 --y 1e-4 --radius -1 --json"), 2);
+  // Out-of-range magnet parameters: remanence 5 T, negative tip depth.
+  EXPECT_EQ(run_cli("field probe --preset black --x 0 --y 1e-4 --br 5 --json"), 2);
+  EXPECT_EQ(run_cli("field probe --preset color --x 0 --y 1e-4 --tip-depth 0.5 --json"), 2);
+  ASSERT_EQ(run_cli("field probe --preset black --x 0 --y 1e-4 --br 0.6 --json", &out), 0);
+  EXPECT_NE(out.find("\"Fy_N\""), std::string::npos);
   const std::string small = tmp_path("small.csv");
   io::write_file_atomic(small, io::field_to_csv(knife, -1e-4, 1e-4, 5, 0, 1e-4, 5));
   EXPECT_EQ(run_cli("field probe --map " + small + " --x 0 --y 5e-5 --json"), 0);
