@@ -32,8 +32,10 @@ TEST(MagnetMoment, CurveIsLinearThenSaturatedAndAlongB) {
     const Vec2 M = magnetisation(p, b * e);
     const double expect = p.Ms_A_per_m * std::min(b / p.B_sat_T, 1.0);
     EXPECT_NEAR(norm(M), expect, 1e-12 * p.Ms_A_per_m) << b;
-    if (b > 0) EXPECT_NEAR(cross(M, e), 0.0, 1e-9) << b;
-    if (b > 0) EXPECT_GT(dot(M, e), 0.0);
+    if (b > 0) {
+      EXPECT_NEAR(cross(M, e), 0.0, 1e-9) << b;
+      EXPECT_GT(dot(M, e), 0.0);
+    }
   }
   // Colour toner d50 (R = 6 um) at saturation: 4/3 pi R^3 * 0.025 * 1.65e6 = 3.73e-11 A m^2.
   EXPECT_NEAR(saturation_moment(p, 6e-6), 3.7322e-11, 1e-4 * 3.7322e-11);
