@@ -37,7 +37,7 @@ int main() {
   for (auto& p : pts) p = {rng.uniform(-450e-6, 450e-6), rng.uniform(5e-6, 350e-6)};
   const auto knife = magnet::make_knife();
   const auto pole = magnet::make_color_pole();
-  const auto map = io::FieldMap::from_csv(io::field_to_csv(knife, -500e-6, 500e-6, 201, 0.0, 400e-6, 81), "bench map");
+  const auto map = io::FieldMap::sample(knife, -500e-6, 500e-6, 201, 0.0, 400e-6, 81);
   // Best of 7 trials: the machine is shared, the minimum is the least disturbed figure.
   double a = 1e300, c = 1e300, m = 1e300;
   for (int t = 0; t < 7; ++t) {

@@ -85,6 +85,10 @@ TEST(FieldMap, ReproducesAnalyticKnifeField) {
   }
   // Grid nodes are reproduced exactly (Hermite interpolation): 1e-14 T.
   EXPECT_NEAR(map.at({0, 100e-6}).B.x, knife.at({0, 100e-6}).B.x, 1e-14);
+  // FieldMap::sample builds the same map (same nodes, same values): identical to 1e-15 T.
+  const auto s = FieldMap::sample(knife, -500e-6, 500e-6, 101, 50e-6, 550e-6, 51);
+  for (Vec2 p : {Vec2{-123e-6, 234e-6}, Vec2{300e-6, 77e-6}})
+    EXPECT_NEAR(norm(s.at(p).B - map.at(p).B), 0.0, 1e-15);
 }
 
 TEST(FieldMap, InterpolationConvergesAtFourthAndThirdOrder) {

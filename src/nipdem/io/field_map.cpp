@@ -242,6 +242,22 @@ FieldMap FieldMap::from_csv(std::string_view text, const std::string& where) {
   return FieldMap(ux.front(), uy.front(), hx, hy, nx, ny, std::move(Bx), std::move(By), where);
 }
 
+FieldMap FieldMap::sample(const magnet::MagnetField& field, double x0, double x1, int nx, double y0, double y1, int ny) {
+  if (nx < 5 || ny < 5) throw_input("FieldMap::sample", "nx/ny", fmt::format("{}/{}", nx, ny), "grid too small", ">= 5");
+  if (!(x1 > x0) || !(y1 > y0)) throw_input("FieldMap::sample", "x1/y1", "", "empty region", "x1 > x0, y1 > y0");
+  const double hx = (x1 - x0) / (nx - 1), hy = (y1 - y0) / (ny - 1);
+  std::vector<double> bx, by;
+  bx.reserve(static_cast<std::size_t>(nx) * ny);
+  by.reserve(static_cast<std::size_t>(nx) * ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const auto s = field.at({x0 + i * hx, y0 + j * hy});
+      bx.push_back(s.B.x);
+      by.push_back(s.B.y);
+    }
+  return FieldMap(x0, y0, hx, hy, nx, ny, std::move(bx), std::move(by), "sampled " + field.describe());
+}
+
 FieldMap FieldMap::from_file(const std::filesystem::path& path) { return from_csv(read_file(path), path.string()); }
 
 std::string field_to_csv(const magnet::MagnetField& field, double x0, double x1, int nx, double y0, double y1, int ny,

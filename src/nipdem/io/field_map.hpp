@@ -39,6 +39,10 @@ class FieldMap final : public magnet::MagnetField {
   // Parses the CSV format above; `where` (file name) is used in every error message.
   static FieldMap from_csv(std::string_view text, const std::string& where);
   static FieldMap from_file(const std::filesystem::path& path);
+  // Samples any field source on the regular grid [x0,x1] x [y0,y1] (nx x ny nodes) -- e.g. to turn
+  // the analytic knife into a cheaper table for the engine (see docs/magnetic.md, Speed).
+  static FieldMap sample(const magnet::MagnetField& field, double x0_m, double x1_m, int nx, double y0_m, double y1_m,
+                         int ny);
 
   magnet::Sample at(Vec2 p) const override;
   std::string describe() const override;
