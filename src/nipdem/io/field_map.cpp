@@ -69,7 +69,7 @@ std::vector<double> grid_axis(const std::string& where, const std::string& name,
     throw_input(where, name, fmt::format("{} distinct values", u.size()), "grid too small", ">= 5 nodes per axis");
   const double h = (u.back() - u.front()) / static_cast<double>(u.size() - 1);
   for (std::size_t i = 0; i < u.size(); ++i) {
-    if (std::abs(u[i] - (u.front() + static_cast<double>(i) * h)) > 1e-6 * h)
+    if (std::abs(u[i] - (u.front() + static_cast<double>(i) * h)) > 1e-3 * h)  // FEM exports print ~6 digits
       throw_input(where, name, fmt::format("{:.9g}", u[i]),
                   fmt::format("grid is not regular (node {} deviates from uniform spacing {:g})", i, h),
                   "uniformly spaced values");
@@ -232,7 +232,7 @@ FieldMap FieldMap::from_csv(std::string_view text, const std::string& where) {
   for (std::size_t r = 0; r < xs.size(); ++r) {
     const double si = (xs[r] - ux.front()) / hx, sj = (ys[r] - uy.front()) / hy;
     const long i = std::lround(si), j = std::lround(sj);
-    if (std::abs(si - i) > 1e-6 || std::abs(sj - j) > 1e-6)
+    if (std::abs(si - i) > 1e-3 || std::abs(sj - j) > 1e-3)
       throw_input(where, "row", fmt::format("({:g}, {:g})", xs[r], ys[r]), "point is not on the regular grid");
     const std::size_t k = static_cast<std::size_t>(j) * nx + static_cast<std::size_t>(i);
     if (seen[k]) throw_input(where, "row", fmt::format("({:g}, {:g})", xs[r], ys[r]), "grid node given twice");

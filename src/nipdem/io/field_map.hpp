@@ -11,7 +11,8 @@
 //   x_m | x_mm | x_um,  y_m | y_mm | y_um,  Bx_T | Bx_mT,  By_T | By_mT
 // (values are converted to SI). Rows may come in any order but must fill a regular grid:
 // every (x_i, y_j) of nx uniformly spaced x values times ny uniformly spaced y values exactly once,
-// nx, ny >= 5. Coordinates are in the magnet frame of magnet_field.hpp.
+// nx, ny >= 5. Spacing must be uniform within 0.1 % of the step (so exports printed with ~6
+// significant digits pass); nodes are snapped to the uniform grid. Coordinates are in the magnet frame of magnet_field.hpp.
 //
 // Interpolation: bicubic Hermite patches per component, with nodal derivatives dB/dx, dB/dy and
 // d2B/dxdy from 4th-order finite differences (central inside, one-sided at the border). The result
