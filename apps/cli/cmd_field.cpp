@@ -1,0 +1,199 @@
+// `nipdem field probe|line`: the magnet field (analytic preset or imported map), its gradient and
+// the magnet force on a toner particle (thesis §2.4.2 eq. 2.4.34, §4.5 eq. 4.5.1; fig. 2.12 analogue).
+#include <cmath>
+#include <cstdio>
+#include <fmt/format.h>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/field_map.hpp"
+#include "nipdem/models/magnet_field.hpp"
+#include "registry.hpp"
+
+namespace {
+using namespace nipdem;
+
+struct Common {
+  std::string preset = "black";
+  std::string map;
+  double radius = 0.0;  // 0 = d50/2 of the preset toner
+  double tip_depth = -1.0;  // < 0: preset default
+  double br = -100.0;       // < -99: preset default
+  bool json = false;
+};
+
+struct Setup {
+  std::unique_ptr<magnet::MagnetField> field;
+  magnet::MagnetisationParams toner;
+  double radius;
+};
+
+Setup make_setup(const Common& c) {
+  Setup s;
+  s.toner = magnet::preset_toner(c.preset);
+  s.radius = c.radius == 0.0 ? magnet::preset_d50_radius(c.preset) : c.radius;
+  require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
+  const bool custom = c.tip_depth >= 0.0 || c.br > -99.0;
+  if (!c.map.empty()) {
+    if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
+    s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
+  } else if (custom && c.preset == "black") {
+    magnet::KnifeParams k;
+    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
+    if (c.br > -99.0) k.blade_Br_T = c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
+  } else if (custom && c.preset == "color") {
+    magnet::ColorPoleParams k;
+    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
+    if (c.br > -99.0) k.Br_T = c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
+  } else {
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
+  }
+  return s;
+}
+
+void add_common(CLI::App* sub, Common& c) {
+  sub->add_option("--preset", c.preset, "magnet and toner preset: black or color")->capture_default_str();
+  sub->add_option("--map", c.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
+  sub->add_option("--radius", c.radius, "toner radius [m] (default: d50/2 of the preset toner, Table 2.1)");
+  sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m]");
+  sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T]");
+  sub->add_flag("--json", c.json, "print one JSON object on stdout");
+}
+
+struct ProbeOpts {
+  Common c;
+  double x = 0, y = 100e-6;
+};
+struct ExportOpts {
+  std::string preset = "black";
+  double x0 = -500e-6, x1 = 500e-6, y0 = 0.0, y1 = 400e-6;
+  int nx = 51, ny = 21;
+  std::string out;
+};
+struct LineOpts {
+  Common c;
+  double y = 100e-6, x0 = -500e-6, x1 = 500e-6;
+  int n = 201;
+  std::string out;
+};
+
+nipdem::cli::Register reg([](CLI::App& app) {
+  auto* field = nipdem::cli::group(app, "field", "Magnet field of the imaging roller and the force on toner");
+
+  auto* probe = field->add_subcommand("probe", "B, grad B and the magnet force on a toner particle at one point");
+  auto po = std::make_shared<ProbeOpts>();
+  add_common(probe, po->c);
+  probe->add_option("--x", po->x, "x [m] along the process direction, 0 at the magnet edge")->required();
+  probe->add_option("--y", po->y, "y [m] above the imaging-roller surface")->required();
+  probe->callback([po] {
+    require_range("field probe", "x_m", po->x, -1.0, 1.0);
+    require_range("field probe", "y_m", po->y, -1.0, 1.0);
+    const Setup s = make_setup(po->c);
+    const auto smp = s.field->at({po->x, po->y});
+    const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+    const Vec2 F = magnet::dipole_force(m, smp);
+    if (po->c.json) {
+      nlohmann::json j{{"preset", po->c.preset},
+                       {"source", s.field->describe()},
+                       {"x_m", po->x},
+                       {"y_m", po->y},
+                       {"Bx_T", smp.B.x},
+                       {"By_T", smp.B.y},
+                       {"B_T", norm(smp.B)},
+                       {"dBx_dx_T_per_m", smp.dB.xx},
+                       {"dBx_dy_T_per_m", smp.dB.xy},
+                       {"dBy_dx_T_per_m", smp.dB.yx},
+                       {"dBy_dy_T_per_m", smp.dB.yy},
+                       {"radius_m", s.radius},
+                       {"mx_Am2", m.x},
+                       {"my_Am2", m.y},
+                       {"moment_Am2", norm(m)},
+                       {"Fx_N", F.x},
+                       {"Fy_N", F.y},
+                       {"force_N", norm(F)}};
+      cli::print_json(j.dump());
+    } else {
+      std::printf("%s\n", s.field->describe().c_str());
+      std::printf("  point          (%g, %g) m\n", po->x, po->y);
+      std::printf("  B              (%.6g, %.6g) T, |B| = %.6g T\n", smp.B.x, smp.B.y, norm(smp.B));
+      std::printf("  grad B         [[%.6g, %.6g], [%.6g, %.6g]] T/m\n", smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy);
+      std::printf("  toner R        %g m, moment (%.4g, %.4g) A m^2\n", s.radius, m.x, m.y);
+      std::printf("  magnet force   (%.6g, %.6g) N, |F| = %.6g N\n", F.x, F.y, norm(F));
+    }
+  });
+
+  auto* exp = field->add_subcommand("export", "Sample a preset magnet on a regular grid as a field-map CSV");
+  auto eo = std::make_shared<ExportOpts>();
+  exp->add_option("--preset", eo->preset, "magnet preset: black or color")->capture_default_str();
+  exp->add_option("--x0", eo->x0, "first x [m]")->capture_default_str();
+  exp->add_option("--x1", eo->x1, "last x [m]")->capture_default_str();
+  exp->add_option("--nx", eo->nx, "nodes along x (>= 5)")->capture_default_str();
+  exp->add_option("--y0", eo->y0, "first y [m]")->capture_default_str();
+  exp->add_option("--y1", eo->y1, "last y [m]")->capture_default_str();
+  exp->add_option("--ny", eo->ny, "nodes along y (>= 5)")->capture_default_str();
+  exp->add_option("--out", eo->out, "output CSV file (written atomically)")->required();
+  exp->callback([eo] {
+    require_range("field export", "nx", eo->nx, 5, 1e5);
+    require_range("field export", "ny", eo->ny, 5, 1e5);
+    if (!(eo->x1 > eo->x0)) throw_input("field export", "x1_m", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
+    if (!(eo->y1 > eo->y0)) throw_input("field export", "y1_m", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
+    const auto f = magnet::preset_field(eo->preset);
+    io::write_file_atomic(eo->out, io::field_to_csv(f, eo->x0, eo->x1, eo->nx, eo->y0, eo->y1, eo->ny,
+                                                    f.describe() + ", magnet frame (see docs/magnetic.md)"));
+    std::fprintf(stderr, "wrote %s (%d x %d nodes)\n", eo->out.c_str(), eo->nx, eo->ny);
+  });
+
+  auto* line = field->add_subcommand("line", "CSV of |B|, grad B and the magnet force along a line y = const");
+  auto lo = std::make_shared<LineOpts>();
+  add_common(line, lo->c);
+  line->add_option("--y", lo->y, "height above the roller surface [m]")->capture_default_str();
+  line->add_option("--x0", lo->x0, "first x [m]")->capture_default_str();
+  line->add_option("--x1", lo->x1, "last x [m]")->capture_default_str();
+  line->add_option("--n", lo->n, "number of points")->capture_default_str();
+  line->add_option("--out", lo->out, "output CSV file (written atomically)")->required();
+  line->callback([lo] {
+    require_range("field line", "n", lo->n, 2, 1e6);
+    require_range("field line", "y_m", lo->y, -1.0, 1.0);
+    require_range("field line", "x0_m", lo->x0, -1.0, 1.0);
+    require_range("field line", "x1_m", lo->x1, -1.0, 1.0);
+    if (!(lo->x1 > lo->x0)) throw_input("field line", "x1_m", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
+    const Setup s = make_setup(lo->c);
+    std::string csv = fmt::format("# {}; toner preset {}, R = {:g} m; force F = (m.grad)B, m = m(B) of eq. 4.5.1\n",
+                                  s.field->describe(), lo->c.preset, s.radius);
+    csv += "x_m,y_m,Bx_T,By_T,B_T,dBx_dx_T_per_m,dBx_dy_T_per_m,dBy_dx_T_per_m,dBy_dy_T_per_m,mx_Am2,my_Am2,Fx_N,Fy_N,F_N\n";
+    std::vector<double> crossings;
+    double prev_fx = 0, prev_x = 0, fmax = 0;
+    for (int i = 0; i < lo->n; ++i) {
+      const double x = lo->x0 + (lo->x1 - lo->x0) * i / (lo->n - 1);
+      const auto smp = s.field->at({x, lo->y});
+      const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+      const Vec2 F = magnet::dipole_force(m, smp);
+      csv += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
+                         x, lo->y, smp.B.x, smp.B.y, norm(smp.B), smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy, m.x, m.y,
+                         F.x, F.y, norm(F));
+      if (i > 0 && (prev_fx > 0) != (F.x > 0))  // linear interpolation of the sign change of F_x
+        crossings.push_back(prev_x + (x - prev_x) * prev_fx / (prev_fx - F.x));
+      prev_fx = F.x;
+      prev_x = x;
+      fmax = std::max(fmax, norm(F));
+    }
+    io::write_file_atomic(lo->out, csv);
+    if (lo->c.json) {
+      cli::print_json(nlohmann::json{{"out", lo->out},
+                                     {"n", lo->n},
+                                     {"y_m", lo->y},
+                                     {"fx_sign_changes_m", crossings},
+                                     {"max_force_N", fmax}}
+                          .dump());
+    } else {
+      std::printf("wrote %s (%d points); F_x changes sign at", lo->out.c_str(), lo->n);
+      for (double c : crossings) std::printf(" %.4g m", c);
+      std::printf("\n");
+    }
+  });
+});
+}  // namespace
