@@ -6,6 +6,7 @@
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
+#include "nipdem/experiments/nip_forces.hpp"
 #include "nipdem/geometry/walls.hpp"
 
 namespace nipdem::experiments {
@@ -51,6 +52,7 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   drum.omega = -cfg_.drum_speed / cfg_.drum_radius;
   drum.interaction = 2;
   sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
+  if (auto field = make_magnet_field(cfg_.magnet)) sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
   if (cfg_.prefill) prefill();
 }
 

@@ -121,6 +121,23 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     s.finish();
   }
   {
+    auto s = top.sub("magnet");
+    c.magnet.field = s.choice("field", {"knife", "color_pole", "map", "none"}, c.magnet.field);
+    c.magnet.map_file = s.string("map_file", "");
+    if (c.magnet.field == "map" && c.magnet.map_file.empty())
+      throw_input(file, "magnet.map_file", "", "field = \"map\" needs a map_file (CSV x_m,y_m,Bx_T,By_T)");
+    const std::string pig = s.choice("pigment", {"black", "color"}, "black");
+    c.magnet.toner = pig == "black" ? magnet::black_toner() : magnet::color_toner();
+    c.magnet.toner.Ms_A_per_m = s.number("saturation_magnetisation_A_per_m", 1e-3, 1e7, c.magnet.toner.Ms_A_per_m);
+    c.magnet.toner.B_sat_T = s.number("saturation_flux_T", 1e-6, 10.0, c.magnet.toner.B_sat_T);
+    c.magnet.toner.eta = s.number("pigment_volume_fraction", 1e-6, 1.0, c.magnet.toner.eta);
+    c.magnet.dipole_dipole = s.boolean("dipole_dipole", c.magnet.dipole_dipole);
+    c.magnet.dipole_cutoff = s.number("dipole_cutoff_m", 1e-7, 1e-3, c.magnet.dipole_cutoff);
+    c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000, c.magnet.dipole_interval));
+    s.finish();
+    if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
+  }
+  {
     auto s = top.sub("output");
     c.vtk = s.boolean("vtk", true);
     s.finish();

@@ -10,6 +10,7 @@
 
 #include "nipdem/core/vec2.hpp"
 #include "nipdem/engine/simulation.hpp"
+#include "nipdem/experiments/nip_forces.hpp"
 #include "nipdem/experiments/toner.hpp"
 #include "nipdem/models/collision_params.hpp"
 #include "nipdem/models/hamaker.hpp"
@@ -67,6 +68,8 @@ struct NipConfig {
   bool prefill = true;               // start with the layer over the whole window
   // [gravity]
   Vec2 gravity{0.0, -9.81};
+  // [magnet]
+  MagnetConfig magnet;
   // [output]
   bool vtk = true;
 

@@ -86,7 +86,8 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
     snapshot();
   }
   auto next_multiple = [&](double interval) {
-    return (std::floor(run.sim().time() / interval + 1e-9) + 1.0) * interval;
+    // time is a sum of dt, so it lands within dt/2 of a multiple, on either side: round
+    return (std::round(run.sim().time() / interval) + 1.0) * interval;
   };
   double next_out = next_multiple(cfg.output_interval);
   double next_ck = next_multiple(cfg.checkpoint_interval);

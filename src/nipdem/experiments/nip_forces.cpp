@@ -1,0 +1,91 @@
+#include "nipdem/experiments/nip_forces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/io/field_map.hpp"
+#include "nipdem/models/dipole.hpp"
+
+namespace nipdem::experiments {
+
+std::shared_ptr<const magnet::MagnetField> make_magnet_field(const MagnetConfig& c) {
+  if (c.field == "none") return nullptr;
+  if (c.field == "knife") return std::make_shared<magnet::BlockAssembly>(magnet::make_knife());
+  if (c.field == "color_pole") return std::make_shared<magnet::BlockAssembly>(magnet::make_color_pole());
+  if (c.field == "map") return std::make_shared<io::FieldMap>(io::FieldMap::from_file(c.map_file));
+  throw_input("magnet", "magnet.field", c.field, "unknown field source", "knife, color_pole, map, none");
+}
+
+MagnetForce::MagnetForce(std::shared_ptr<const magnet::MagnetField> field, MagnetConfig cfg)
+    : field_(std::move(field)), cfg_(std::move(cfg)) {}
+
+void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<double> fx, std::span<double> fy,
+                      std::span<double>) {
+  const std::size_t n = b.x.size();
+  moment_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double R = 0.5 * b.size[i];
+    const magnet::Sample s = field_->at({b.x[i], b.y[i]});
+    moment_[i] = magnet::induced_moment(cfg_.toner, R, s.B);  // eq. 4.5.1
+    const Vec2 f = magnet::dipole_force(moment_[i], s);         // eq. 2.4.34: (m . grad) B
+    fx[i] += f.x;
+    fy[i] += f.y;
+  }
+  if (!cfg_.dipole_dipole) return;
+  // Re-evaluate the pair forces every dipole_interval calls, or when bodies changed.
+  bool same = dipole_ids_.size() == n;
+  if (same) for (std::size_t i = 0; i < n && same; ++i) same = dipole_ids_[i] == b.id[i];
+  if (!same || calls_ % cfg_.dipole_interval == 0) {
+    dipole_pass(b);
+    dipole_ids_.assign(b.id.begin(), b.id.end());
+  }
+  ++calls_;
+  for (std::size_t i = 0; i < n; ++i) { fx[i] += dfx_[i]; fy[i] += dfy_[i]; }
+}
+
+void MagnetForce::dipole_pass(const BodyStore& b) {
+  const std::size_t n = b.x.size();
+  dfx_.assign(n, 0.0);
+  dfy_.assign(n, 0.0);
+  if (n < 2) return;
+  const double rc = cfg_.dipole_cutoff, rc2 = rc * rc;
+  double xmin = b.x[0], xmax = b.x[0], ymin = b.y[0], ymax = b.y[0];
+  for (std::size_t i = 0; i < n; ++i) {
+    xmin = std::min(xmin, b.x[i]); xmax = std::max(xmax, b.x[i]);
+    ymin = std::min(ymin, b.y[i]); ymax = std::max(ymax, b.y[i]);
+  }
+  const int nx = std::max(1, static_cast<int>((xmax - xmin) / rc) + 1);
+  const int ny = std::max(1, static_cast<int>((ymax - ymin) / rc) + 1);
+  head_.assign(static_cast<std::size_t>(nx) * ny, -1);
+  next_.assign(n, -1);
+  auto cell = [&](std::size_t i) {
+    return std::min(ny - 1, static_cast<int>((b.y[i] - ymin) / rc)) * nx + std::min(nx - 1, static_cast<int>((b.x[i] - xmin) / rc));
+  };
+  for (std::size_t ii = n; ii-- > 0;) {
+    const int c = cell(ii);
+    next_[ii] = head_[c];
+    head_[c] = static_cast<int>(ii);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const int c = cell(i);
+    const int cx = c % nx, cy = c / nx;
+    for (int dy = -1; dy <= 1; ++dy) {
+      if (cy + dy < 0 || cy + dy >= ny) continue;
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (cx + dx < 0 || cx + dx >= nx) continue;
+        for (int j = head_[(cy + dy) * nx + cx + dx]; j >= 0; j = next_[j]) {
+          if (j <= static_cast<int>(i)) continue;
+          const Vec2 r{b.x[i] - b.x[j], b.y[i] - b.y[j]};
+          if (norm2(r) >= rc2) continue;
+          const Vec2 f = dipole::dipole_force(moment_[i], moment_[j], r);  // eqs. 2.4.38-2.4.39, on i
+          dfx_[i] += f.x; dfy_[i] += f.y;
+          dfx_[j] -= f.x; dfy_[j] -= f.y;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace nipdem::experiments
