@@ -545,6 +545,7 @@ void Simulation::save(std::ostream& o) const {
   put(o, np);
   for (std::size_t k = 0; k < np; ++k) { put_vec(o, prov_fx_[k]); put_vec(o, prov_fy_[k]); put_vec(o, prov_tq_[k]); }
   put(o, n_contacts_);
+  for (const auto& f : forces_) f->save(o);
 }
 
 void Simulation::load(std::istream& in) {
@@ -568,6 +569,7 @@ void Simulation::load(std::istream& in) {
   if (np != prov_fx_.size()) throw std::runtime_error("checkpoint has a different number of force providers than the configuration");
   for (std::size_t k = 0; k < np; ++k) { get_vec(in, prov_fx_[k]); get_vec(in, prov_fy_[k]); get_vec(in, prov_tq_[k]); }
   get(in, n_contacts_);
+  for (auto& f : forces_) f->load(in);
   // The list is rebuilt (history carried over by identity mapping) at the next evaluation;
   // forces of the saved state are already in the body arrays.
   old_of_new_.resize(d_.x.size());

@@ -50,6 +50,10 @@ class BodyForce {
   virtual std::string name() const = 0;
   virtual void add(const BodyStore& b, const DiscStore& d, double t, std::span<double> fx, std::span<double> fy,
                    std::span<double> torque) = 0;
+  // State the provider carries between evaluations (held forces, charges, counters), saved
+  // with the engine's checkpoint so that a resumed run is bitwise identical.
+  virtual void save(std::ostream&) const {}
+  virtual void load(std::istream&) {}
 };
 
 struct EngineParams {

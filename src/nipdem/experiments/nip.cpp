@@ -53,6 +53,10 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   drum.interaction = 2;
   sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
   if (auto field = make_magnet_field(cfg_.magnet)) sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
+  if (cfg_.electric.enabled) {
+    electric_ = std::make_shared<ElectricForce>(sim_.get(), cfg_.electric);
+    sim_->add_force(electric_);
+  }
   if (cfg_.prefill) prefill();
 }
 
@@ -140,7 +144,9 @@ void NipRun::exchange() {
     const bool escaped = gd < -0.5 * cfg_.size.d50 || gr < -rough - 0.5 * cfg_.size.d50 || !std::isfinite(p.x) || !std::isfinite(p.y);
     const bool outside = p.x < cfg_.x_min || p.x > cfg_.x_max;
     if (!escaped && !outside) return false;
-    const Exit e = escaped ? Exit::lost : (gd < gr ? Exit::developed : Exit::returned);
+    // Developed: left downstream (x < x_min, the drum's direction of travel) nearer the drum.
+    // Everything else that leaves the window goes back towards the supply roller.
+    const Exit e = escaped ? Exit::lost : (p.x < cfg_.x_min && gd < gr ? Exit::developed : Exit::returned);
     removals_.push_back({t, e, p.x, p.y, b.size[i], b.id[i]});
     ++removed_[static_cast<int>(e)];
     return true;
@@ -182,7 +188,7 @@ template <class T> void get(const std::string& s, std::size_t& pos, T& v) {
 
 std::string NipRun::checkpoint() const {
   std::string s = "NIPDEMRUN1";
-  const std::uint64_t h = std::hash<std::string>{}(cfg_.resolved_toml);
+  const std::uint64_t h = std::hash<std::string>{}(cfg_.resume_key);
   put(s, h);
   for (int i = 0; i < 4; ++i) put(s, rng_.state()[i]);
   put(s, inserted_);
@@ -202,8 +208,8 @@ void NipRun::restore(const std::string& blob) {
   std::size_t pos = 10;
   std::uint64_t h;
   get(blob, pos, h);
-  if (h != std::hash<std::string>{}(cfg_.resolved_toml))
-    throw InputError("checkpoint was written with a different configuration; resume needs the same config and --set options");
+  if (h != std::hash<std::string>{}(cfg_.resume_key))
+    throw InputError("checkpoint was written with a different configuration; --resume needs the same config and --set options (only run.end_time_s and the output intervals may change)");
   std::uint64_t st[4];
   for (auto& v : st) get(blob, pos, v);
   rng_.set_state(st);
@@ -234,6 +240,35 @@ nlohmann::json NipRun::describe() const {
       {"window_x_m", {cfg_.x_min, cfg_.x_max}},
       {"gap_m", cfg_.gap},
   };
+}
+
+std::vector<NipRun::CoverageBin> NipRun::coverage(double bin) const {
+  std::vector<CoverageBin> out;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const auto& e : removals_) {
+    if (e.where != Exit::developed) continue;
+    const double s = drum_position(e.time, e.x);
+    lo = std::min(lo, s - e.size / 2);
+    hi = std::max(hi, s + e.size / 2);
+  }
+  // the pattern's segments define the region of interest as well
+  for (const auto& seg : cfg_.electric.pattern.segments()) { lo = std::min(lo, seg.begin_m); hi = std::max(hi, seg.end_m); }
+  if (!(hi > lo)) return out;
+  lo = std::floor(lo / bin) * bin - 5 * bin;
+  hi = std::ceil(hi / bin) * bin + 5 * bin;
+  const int n = static_cast<int>(std::lround((hi - lo) / bin));
+  for (int k = 0; k < n; ++k) out.push_back({lo + k * bin, lo + (k + 1) * bin, 0, false});
+  for (const auto& e : removals_) {
+    if (e.where != Exit::developed) continue;
+    const double s = drum_position(e.time, e.x);
+    // a particle covers every bin its diameter overlaps (presence = 100 %, §5.3)
+    const int k0 = std::max(0, static_cast<int>(std::floor((s - e.size / 2 - lo) / bin)));
+    const int k1 = std::min(n - 1, static_cast<int>(std::floor((s + e.size / 2 - lo) / bin)));
+    for (int k = k0; k <= k1; ++k) out[k].covered = true;
+    const int kc = static_cast<int>(std::floor((s - lo) / bin));
+    if (kc >= 0 && kc < n) ++out[kc].particles;
+  }
+  return out;
 }
 
 }  // namespace nipdem::experiments

@@ -19,6 +19,7 @@
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/experiments/nip_forces.hpp"
 
 namespace nipdem::experiments {
 
@@ -48,6 +49,15 @@ class NipRun {
   std::int64_t inserted() const { return inserted_; }
   std::int64_t removed(Exit e) const { return removed_[static_cast<int>(e)]; }
   const std::vector<RemovalEvent>& removals() const { return removals_; }
+  // The electric force provider (null unless [electric] enabled).
+  const ElectricForce* electric() const { return electric_.get(); }
+  // Position on the drum surface (arc length, s = 0 at the nip at t = 0, increasing with the
+  // drum's travel) of a particle that left on the drum at time t and position x: the print
+  // pattern's coordinate (§2.5.1).
+  double drum_position(double t, double x) const { return cfg_.drum_speed * t + (x - cfg_.nip_x); }
+  // Coverage along the drum from the developed particles: presence/absence per bin (§5.3).
+  struct CoverageBin { double s0, s1; int particles; bool covered; };
+  std::vector<CoverageBin> coverage(double bin_m) const;
 
   // Geometry helpers.
   Vec2 drum_centre() const;
@@ -74,6 +84,7 @@ class NipRun {
   double area_debt_ = 0.0;  // toner area still to insert [m^2]
   std::vector<RemovalEvent> removals_;
   const ClusterTemplate* tmpl_ = nullptr;
+  std::shared_ptr<ElectricForce> electric_;
 };
 
 }  // namespace nipdem::experiments

@@ -9,6 +9,8 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
+#include "nipdem/io/print_pattern.hpp"
+#include <filesystem>
 
 namespace nipdem::experiments {
 
@@ -138,6 +140,38 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
   }
   {
+    auto s = top.sub("electric");
+    auto& e = c.electric;
+    e.enabled = s.boolean("enabled", false);
+    e.force.model = electric::parse_force_model(s.choice("model", {"exact", "series", "approx"}, "exact"), file, "electric.model");
+    e.force.approx_coefficient = s.number("approx_coefficient", 1e-3, 10.0, e.force.approx_coefficient);
+    e.dielectric_layer = s.boolean("dielectric_layer", true);
+    e.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-4, e.layer_thickness);
+    e.layer_permittivity = s.number("layer_permittivity", 1.0, 1e4, e.layer_permittivity);
+    e.rc = s.choice("charge_preset", {"black", "color"}, "black") == "black" ? charge::RcChargeParams::black() : charge::RcChargeParams::colour();
+    e.rc.R_tt_ohm = s.number("R_tt_ohm", 1.0, 1e30, e.rc.R_tt_ohm);
+    e.rc.R_ti_ohm = s.number("R_ti_ohm", 1.0, 1e30, e.rc.R_ti_ohm);
+    e.rc.C_td_F = s.number("C_td_F", 1e-25, 1e-6, e.rc.C_td_F);
+    e.rc.R_td_ohm = s.number("R_td_ohm", 1.0, 1e40, e.rc.R_td_ohm);
+    e.rc.range_m = s.number("range_m", 1e-8, 1e-3, c.size.d50);
+    e.corridor_fraction = s.number("corridor_fraction", 0.0, 0.999, 0.0);
+    e.path_interval = static_cast<int>(s.integer("path_interval_steps", 1, 1000000, e.path_interval));
+    s.finish();
+    e.force.validate();
+    e.rc.validate();
+    e.drum_speed = c.drum_speed;
+    e.drum_centre = {c.nip_x, c.gap + c.drum_radius};
+    e.drum_radius = c.drum_radius;
+    toml::table* print = root["print"].as_table();
+    top.sub("print");  // its keys are checked by the pattern parser
+    if (print) {
+      e.pattern = io::pattern_from_toml(*print, file, std::filesystem::path(file).parent_path());
+    } else {
+      e.pattern = io::PrintPattern::none();
+    }
+    if (e.enabled && !print) throw_input(file, "print", "", "[electric] enabled = true needs a [print] table (e.g. pattern = \"line\")");
+  }
+  {
     auto s = top.sub("output");
     c.vtk = s.boolean("vtk", true);
     s.finish();
@@ -157,6 +191,16 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   std::ostringstream ss;
   ss << root;
   c.resolved_toml = ss.str();
+  // A resumed run may extend the end time and change the output cadence; nothing else
+  // (e.g. the thread count changes the floating-point summation order).
+  if (auto* run = root["run"].as_table()) {
+    run->erase("end_time_s");
+    run->erase("output_interval_s");
+    run->erase("checkpoint_interval_s");
+  }
+  std::ostringstream rk;
+  rk << root;
+  c.resume_key = rk.str();
   choose_time_step(c);  // refuses a time step above the stability bound
   return c;
 }

@@ -70,11 +70,14 @@ struct NipConfig {
   Vec2 gravity{0.0, -9.81};
   // [magnet]
   MagnetConfig magnet;
+  // [electric] and [print]
+  ElectricConfig electric;
   // [output]
   bool vtk = true;
 
   std::vector<ClusterTemplate> templates;  // resolved library
   std::string resolved_toml;               // the effective configuration (for summary.json)
+  std::string resume_key;                  // the configuration minus keys a resume may change
 };
 
 // Loads and validates. `overrides` are KEY=VALUE strings (from --set).

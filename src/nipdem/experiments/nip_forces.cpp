@@ -7,6 +7,8 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/models/dipole.hpp"
+#include "nipdem/models/electric_screening.hpp"
+#include <set>
 
 namespace nipdem::experiments {
 
@@ -85,6 +87,159 @@ void MagnetForce::dipole_pass(const BodyStore& b) {
         }
       }
     }
+  }
+}
+
+
+ElectricForce::ElectricForce(const engine::Simulation* sim, ElectricConfig cfg) : sim_(sim), cfg_(std::move(cfg)) {
+  cfg_.rc.validate();
+  cfg_.force.validate();
+}
+
+namespace {
+template <class T> void put(std::ostream& o, const T& v) { o.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
+template <class T> void put_vec(std::ostream& o, const std::vector<T>& v) {
+  const std::uint64_t n = v.size();
+  put(o, n);
+  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
+}
+template <class T> void get(std::istream& i, T& v) {
+  if (!i.read(reinterpret_cast<char*>(&v), sizeof(T))) throw std::runtime_error("checkpoint truncated (force provider)");
+}
+template <class T> void get_vec(std::istream& i, std::vector<T>& v) {
+  std::uint64_t n;
+  get(i, n);
+  if (n > (1ULL << 32)) throw std::runtime_error("checkpoint corrupt (force provider)");
+  v.resize(n);
+  if (!i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))))
+    throw std::runtime_error("checkpoint truncated (force provider)");
+}
+}  // namespace
+
+void MagnetForce::save(std::ostream& o) const {
+  put(o, calls_); put_vec(o, dipole_ids_); put_vec(o, dfx_); put_vec(o, dfy_);
+}
+void MagnetForce::load(std::istream& in) {
+  get(in, calls_); get_vec(in, dipole_ids_); get_vec(in, dfx_); get_vec(in, dfy_);
+}
+
+void ElectricForce::save(std::ostream& o) const {
+  put(o, calls_); put(o, t_last_); put(o, v_drum_); put(o, n_printable_);
+  put_vec(o, u_); put_vec(o, ids_); put_vec(o, coupling_); put_vec(o, printable_); put_vec(o, near_disc_);
+  put_vec(o, gap_); put_vec(o, r_path_);
+}
+void ElectricForce::load(std::istream& in) {
+  get(in, calls_); get(in, t_last_); get(in, v_drum_); get(in, n_printable_);
+  get_vec(in, u_); get_vec(in, ids_); get_vec(in, coupling_); get_vec(in, printable_); get_vec(in, near_disc_);
+  get_vec(in, gap_); get_vec(in, r_path_);
+  paths_.resize(0);  // rebuilt from the contacts at the next refresh (exact, same distances)
+}
+
+void ElectricForce::refresh(const BodyStore& b, const DiscStore& d) {
+  const std::size_t nb = b.x.size();
+  const auto& walls = sim_->walls();
+  const auto& drum = walls[cfg_.drum_wall];
+  const auto& roller = walls[cfg_.roller_wall];
+  // Contacts between bodies (from disc overlaps in the neighbour list) and with the roller.
+  const auto& nl = sim_->neighbor_list();
+  std::set<std::pair<int, int>> pairs;
+  for (std::size_t i = 0; i + 1 < nl.row_start_.size() && i < d.x.size(); ++i) {
+    for (int e = nl.row_start_[i]; e < nl.row_start_[i + 1]; ++e) {
+      const int j = nl.nbr_[e];
+      const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j], rs = d.r[i] + d.r[j];
+      if (dx * dx + dy * dy < rs * rs) {
+        const int a = d.body[i], c = d.body[j];
+        pairs.insert({std::min(a, c), std::max(a, c)});
+      }
+    }
+  }
+  std::vector<conduction::Contact> contacts;
+  contacts.reserve(pairs.size());
+  for (auto& [a, c] : pairs) contacts.push_back({a, c, cfg_.rc.R_tt_ohm});
+  std::vector<conduction::RollerContact> roll;
+  std::vector<geometry::WallHit> hits;
+  std::vector<char> on_roller(nb, 0);
+  near_disc_.assign(nb, -1);
+  gap_.assign(nb, std::numeric_limits<double>::infinity());
+  for (std::size_t k = 0; k < d.x.size(); ++k) {
+    const int bi = d.body[k];
+    hits.clear();
+    roller.query({d.x[k], d.y[k]}, d.r[k], 0.0, hits);
+    for (auto& h : hits) if (h.gap < 0.0) on_roller[bi] = 1;
+    const double g = norm(Vec2{d.x[k], d.y[k]} - drum.centre) - drum.radius - d.r[k];
+    if (g < gap_[bi]) { gap_[bi] = g; near_disc_[bi] = static_cast<int>(k); }
+  }
+  for (std::size_t i = 0; i < nb; ++i) if (on_roller[i]) roll.push_back({static_cast<int>(i), cfg_.rc.R_ti_ohm});
+  if (paths_.size() != static_cast<int>(nb)) paths_.resize(static_cast<int>(nb));
+  paths_.update(contacts, roll);
+  r_path_.assign(nb, charge::kNoPath);
+  for (std::size_t i = 0; i < nb; ++i) r_path_[i] = paths_.path_resistance(static_cast<int>(i));
+  // Who feels the force: within range of the drum and not screened (§2.5.4).
+  std::vector<electric::Disc> layer;
+  std::vector<int> layer_disc;
+  const double reach = cfg_.rc.range_m + 2.0 * cfg_.rc.range_m;
+  for (std::size_t k = 0; k < d.x.size(); ++k) {
+    if (norm(Vec2{d.x[k], d.y[k]} - drum.centre) - drum.radius - d.r[k] < reach) {
+      layer.push_back({{d.x[k], d.y[k]}, d.r[k]});
+      layer_disc.push_back(static_cast<int>(k));
+    }
+  }
+  const auto surface = electric::DrumSurface::circle(drum.centre, drum.radius);
+  electric::ScreeningParams sp;
+  sp.range_m = cfg_.rc.range_m;
+  sp.corridor_fraction = cfg_.corridor_fraction;
+  coupling_.assign(nb, charge::DrumCoupling::none);
+  printable_.assign(nb, 0);
+  n_printable_ = 0;
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (!(gap_[i] < cfg_.rc.range_m)) continue;
+    coupling_[i] = gap_[i] < 0.0 ? charge::DrumCoupling::contact : charge::DrumCoupling::capacitor;
+    const int k = near_disc_[i];
+    // screening by discs of other bodies only (a particle's own members never screen it)
+    bool screened = false;
+    const electric::Disc self{{d.x[k], d.y[k]}, d.r[k]};
+    std::vector<electric::Disc> others;
+    for (std::size_t q = 0; q < layer.size(); ++q) if (d.body[layer_disc[q]] != static_cast<int>(i)) others.push_back(layer[q]);
+    const auto res = electric::screening(self, surface, others, sp);
+    screened = res.screened;
+    if (!screened) { printable_[i] = 1; ++n_printable_; }
+  }
+}
+
+void ElectricForce::add(const BodyStore& b, const DiscStore& d, double t, std::span<double> fx, std::span<double> fy,
+                        std::span<double> torque) {
+  const std::size_t nb = b.x.size();
+  // Keep the charges with their bodies when bodies were added or removed.
+  bool same = ids_.size() == nb;
+  if (same) for (std::size_t i = 0; i < nb && same; ++i) same = ids_[i] == b.id[i];
+  if (!same) {
+    std::unordered_map<std::int64_t, double> old;
+    for (std::size_t i = 0; i < ids_.size() && i < u_.size(); ++i) old[ids_[i]] = u_[i];
+    u_.assign(nb, 0.0);
+    for (std::size_t i = 0; i < nb; ++i) { auto it = old.find(b.id[i]); if (it != old.end()) u_[i] = it->second; }
+    ids_.assign(b.id.begin(), b.id.end());
+  }
+  if (!same || calls_ % cfg_.path_interval == 0 || coupling_.size() != nb) refresh(b, d);
+  ++calls_;
+  v_drum_ = cfg_.pattern.voltage_at_time(t, cfg_.drum_speed);
+  const double dt = t_last_ < 0.0 ? 0.0 : t - t_last_;
+  t_last_ = t;
+  const auto& drum = sim_->walls()[cfg_.drum_wall];
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (coupling_[i] == charge::DrumCoupling::none) continue;
+    if (dt > 0.0) u_[i] = charge::rc_update(u_[i], v_drum_, r_path_[i], coupling_[i], cfg_.rc, dt);
+    if (!printable_[i] || u_[i] == 0.0) continue;
+    const int k = near_disc_[i];
+    const Vec2 p{d.x[k], d.y[k]};
+    const double l = std::max(norm(p - drum.centre) - drum.radius - d.r[k], 0.0);
+    const double dd = cfg_.dielectric_layer ? electric::effective_gap(l, cfg_.layer_thickness, cfg_.layer_permittivity) : std::max(l, 1e-12);
+    const double R = 0.5 * b.size[i];
+    const double f = cfg_.force.model == electric::ForceModel::exact ? table_.force(R, std::fabs(u_[i]), dd)
+                                                                      : electric::force(cfg_.force, R, std::fabs(u_[i]), dd);
+    const Vec2 n = (drum.centre - p) / norm(drum.centre - p);  // towards the drum axis
+    fx[i] += f * n.x;
+    fy[i] += f * n.y;
+    torque[i] += d.wx[k] * f * n.y - d.wy[k] * f * n.x;  // applied at the nearest disc
   }
 }
 

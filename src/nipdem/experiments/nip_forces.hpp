@@ -7,6 +7,10 @@
 #include <vector>
 
 #include "nipdem/engine/simulation.hpp"
+#include "nipdem/io/print_pattern.hpp"
+#include "nipdem/models/electric_force.hpp"
+#include "nipdem/models/rc_charge.hpp"
+#include "nipdem/solvers/conduction_path.hpp"
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
@@ -35,6 +39,8 @@ class MagnetForce final : public engine::BodyForce {
   // Dipole-dipole part of the last evaluation, per body [N] (for tests and output).
   const std::vector<double>& dipole_fx() const { return dfx_; }
   const std::vector<double>& dipole_fy() const { return dfy_; }
+  void save(std::ostream& o) const override;
+  void load(std::istream& in) override;
 
  private:
   void dipole_pass(const BodyStore& b);
@@ -46,6 +52,60 @@ class MagnetForce final : public engine::BodyForce {
   long calls_ = 0;
   // cell list scratch
   std::vector<int> head_, next_;
+};
+
+struct ElectricConfig {
+  bool enabled = false;
+  electric::ElectricForceParams force;      // exact | series | approx (§2.5.3; docs/electric.md)
+  bool dielectric_layer = true;             // d = l + d_l/eps_2, eq. 2.5.43
+  double layer_thickness = 600e-9;          // d_l [m]
+  double layer_permittivity = 5.0;          // eps_2 [-]
+  charge::RcChargeParams rc = charge::RcChargeParams::black();  // §2.5.5, §4.7
+  double corridor_fraction = 0.0;           // screening corridor width / r (docs/electric.md)
+  int path_interval = 50;                   // steps between conduction-path/screening updates
+  io::PrintPattern pattern;                 // drum track voltage vs drum surface position
+  double drum_speed = 0.0;                  // [m/s], s = v t at the nip
+  Vec2 drum_centre{};                       // [m]
+  double drum_radius = 0.0;                 // [m]
+  int roller_wall = 0, drum_wall = 1;       // wall indices in the engine
+};
+
+// Electric print force (§2.5): toner within d50 of the drum and not screened by another
+// particle is a capacitor C_td to the drum, charged through its shortest conducting path to
+// the grounded imaging roller (RC model, §2.5.5); the voltage u over that capacitor drives
+// the force of a conducting sphere (radius = volume-equivalent radius) at gap l from a plate
+// (bispherical/capacitance solution, §2.5.3), pulling it towards the drum along the normal
+// through its nearest disc. Paths and screening are refreshed every `path_interval` steps;
+// charges are updated every step (exact exponential update).
+class ElectricForce final : public engine::BodyForce {
+ public:
+  ElectricForce(const engine::Simulation* sim, ElectricConfig cfg);
+  std::string name() const override { return "electric"; }
+  void add(const BodyStore& b, const DiscStore& d, double t, std::span<double> fx, std::span<double> fy,
+           std::span<double> torque) override;
+  // Capacitor voltage u [V] of each body (same order as the body arrays), last evaluation.
+  const std::vector<double>& voltage() const { return u_; }
+  double drum_voltage() const { return v_drum_; }
+  int printable_count() const { return n_printable_; }
+  void save(std::ostream& o) const override;
+  void load(std::istream& in) override;
+
+ private:
+  void refresh(const BodyStore& b, const DiscStore& d);
+  const engine::Simulation* sim_;
+  ElectricConfig cfg_;
+  electric::ElectricForceTable table_;
+  conduction::ConductionPaths paths_;
+  std::vector<double> u_;                   // per body
+  std::vector<std::int64_t> ids_;           // body ids u_ belongs to
+  std::vector<charge::DrumCoupling> coupling_;
+  std::vector<char> printable_;
+  std::vector<int> near_disc_;              // disc of each body nearest the drum
+  std::vector<double> gap_;                 // its surface gap to the drum [m]
+  std::vector<double> r_path_;              // path resistance at the last refresh [ohm]
+  double v_drum_ = 0.0, t_last_ = -1.0;
+  long calls_ = 0;
+  int n_printable_ = 0;
 };
 
 // The field a MagnetConfig names (throws InputError for an unreadable map).

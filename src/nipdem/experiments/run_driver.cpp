@@ -76,6 +76,13 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
   auto save_checkpoint = [&] {
     io::write_file_atomic(ckpt, run.checkpoint());
     io::write_file_atomic(out / "removals.csv", removals_csv(run));
+    if (cfg.electric.enabled) {
+      std::string cov = "s_begin_m,s_end_m,coverage,particles,track_voltage_V\n";
+      for (const auto& b : run.coverage(0.25 * cfg.size.d50))
+        cov += fmt::format("{:.9g},{:.9g},{},{},{:g}\n", b.s0, b.s1, b.covered ? 1 : 0, b.particles,
+                           cfg.electric.pattern.voltage_at(0.5 * (b.s0 + b.s1)));
+      io::write_file_atomic(out / "coverage.csv", cov);
+    }
   };
 
   const std::int64_t step0 = run.sim().step_count();
@@ -138,6 +145,8 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
       {"geometry", run.describe()},
       {"frames", frames.size()},
       {"resumed", opt.resume},
+      {"electric_enabled", cfg.electric.enabled},
+      {"printed", cfg.electric.enabled ? run.removed(Exit::developed) : 0},
   };
   io::write_file_atomic(out / "summary.json", summary.dump(2));
   return summary;

@@ -1,0 +1,156 @@
+// Nip scenarios with bulk observables (chaotic runs are checked on bulk quantities only) and
+// the command-line contract: bad input exits 2 naming file/key/range, results are never lost,
+// checkpoint + resume reproduces an uninterrupted run byte for byte.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "nipdem/experiments/nip.hpp"
+#include "nipdem/experiments/presets.hpp"
+#include "nipdem/io/atomic_file.hpp"
+
+using namespace nipdem;
+using namespace nipdem::experiments;
+namespace fs = std::filesystem;
+
+namespace {
+struct CmdResult { int status; std::string out, err; };
+
+CmdResult run_cli(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("nipdem_test_err_" + std::to_string(::getpid()));
+  const std::string cmd = std::string(NIPDEM_CLI_PATH) + " " + args + " 2>" + err.string();
+  CmdResult r{};
+  FILE* p = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  r.err = io::read_file(err);
+  fs::remove(err);
+  return r;
+}
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+// A small black-unit nip: +-150 um window, softened contacts (stiffness_scale keeps
+// restitution, §4.2.2), a 30 um toner layer on the drum.
+std::vector<std::string> small_nip(double end_time) {
+  return {"geometry.window_x_min_m=-150e-6", "geometry.window_x_max_m=150e-6", "collision.stiffness_scale=0.01",
+          "run.end_time_s=" + std::to_string(end_time), "output.vtk=false"};
+}
+}  // namespace
+
+TEST(NipScenario, MagnetPullsTonerOffTheDrumIntoAnAssemblyAtTheKnife) {
+  // Without a magnet the toner layer rides on the drum; with the black knife it is pulled
+  // across the 150 um gap onto the roller and gathers over the knife edge (thesis §1.2, §5.1).
+  auto fractions = [](const std::string& field) {
+    auto o = small_nip(4e-4);
+    o.push_back("magnet.field=\"" + field + "\"");
+    o.push_back("magnet.dipole_dipole=false");
+    NipRun run(parse_nip_config(preset_text("black"), "preset:black", o));
+    run.advance_to(4e-4);
+    const auto& b = run.sim().bodies();
+    int near_roller = 0, near_drum = 0, n = 0;
+    double xsum = 0;
+    for (std::size_t i = 0; i < b.x.size(); ++i) {
+      const double gr = b.y[i] - run.roller_surface_y(b.x[i]);
+      const double gd = run.drum_surface_y(b.x[i]) - b.y[i];
+      ++n;
+      if (gr < 40e-6) { ++near_roller; xsum += b.x[i]; }
+      if (gd < 35e-6) ++near_drum;
+    }
+    return std::array<double, 3>{double(near_roller) / n, double(near_drum) / n, near_roller ? xsum / near_roller : 1.0};
+  };
+  const auto none = fractions("none");
+  const auto knife = fractions("knife");
+  // Bulk thresholds with wide margins (chaotic flow): without the magnet >= 80 % stay within
+  // the 30 um layer (+5 um) of the drum; with it >= 80 % lie within 40 um of the roller and
+  // their mean x is within 100 um of the knife edge at x = 0 (the window is +-150 um; the
+  // sleeve drags the assembly towards +x, docs/results notes the offset).
+  EXPECT_GT(none[1], 0.8);
+  EXPECT_LT(none[0], 0.2);
+  EXPECT_GT(knife[0], 0.8);
+  EXPECT_LT(knife[1], 0.2);
+  EXPECT_LT(std::fabs(knife[2]), 100e-6);
+}
+
+TEST(NipCli, BadInputExitsTwoNamingFileKeyAndRange) {
+  const fs::path d = temp_dir("badinput");
+  const std::string preset = io::read_file(fs::path(NIPDEM_SOURCE_DIR) / "data/presets/black.toml");
+  struct Case { std::string name, edit, expect1, expect2; };
+  const std::vector<Case> cases = {
+      {"unknown_key", "[geometry]\ngap_mm = 1\n", "geometry.gap_mm", "unknown key"},
+      {"negative_radius", "", "toner.d50_m", "out of range"},
+      {"gap_too_small", "", "geometry.gap_m", "largest particle"},
+      {"dt_above_bound", "", "run.dt_s", "stability bound"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    std::string text = preset;
+    std::string set;
+    if (c.name == "unknown_key") text = "[extra]\n" + preset;  // replaced below
+    const fs::path cfg = d / (c.name + ".toml");
+    if (c.name == "unknown_key") {
+      text = preset;
+      text.replace(text.find("gap_m = 150e-6"), std::string("gap_m = 150e-6").size(), "gap_mm = 150e-6");
+    }
+    if (c.name == "negative_radius") set = "--set toner.d50_m=-1e-6";
+    if (c.name == "gap_too_small") set = "--set geometry.gap_m=12e-6";
+    if (c.name == "dt_above_bound") set = "--set run.dt_s=1e-6";
+    io::write_file_atomic(cfg, text);
+    const auto r = run_cli("run " + cfg.string() + " --out " + (d / c.name).string() + " " + set);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(cfg.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.expect1), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.expect2), std::string::npos) << r.err;
+  }
+  // The allowed range is named (dt bound value, d50 range).
+  const auto r1 = run_cli("run " + (d / "dt_above_bound.toml").string() + " --set run.dt_s=1e-6 --out " + (d / "x").string());
+  EXPECT_NE(r1.err.find("allowed: dt_s <="), std::string::npos) << r1.err;
+  const auto r2 = run_cli("run " + (d / "missing.toml").string());
+  EXPECT_EQ(r2.status, 2);
+  EXPECT_NE(r2.err.find("missing.toml"), std::string::npos) << r2.err;
+  fs::remove_all(d);
+}
+
+TEST(NipCli, ExistingResultsAreNeverOverwrittenAndResumeIsByteIdentical) {
+  const fs::path d = temp_dir("resume");
+  const std::string cfg = (fs::path(NIPDEM_SOURCE_DIR) / "data/presets/black.toml").string();
+  std::string common;
+  for (const auto& s : small_nip(1e-4)) if (s.rfind("run.end_time_s", 0) != 0) common += " --set " + s;
+  common += " --set run.checkpoint_interval_s=5e-5 --set run.output_interval_s=5e-5 --set magnet.dipole_dipole=true --quiet";
+  common += " --set output.vtk=true";
+  // uninterrupted: 0 -> 1e-4 s
+  auto a = run_cli("run " + cfg + " --out " + (d / "a").string() + common + " --set run.end_time_s=1e-4");
+  ASSERT_EQ(a.status, 0) << a.err;
+  // interrupted: 0 -> 5e-5 s, then resume to 1e-4 s
+  auto b1 = run_cli("run " + cfg + " --out " + (d / "b").string() + common + " --set run.end_time_s=5e-5");
+  ASSERT_EQ(b1.status, 0) << b1.err;
+  auto b2 = run_cli("run " + cfg + " --out " + (d / "b").string() + common + " --set run.end_time_s=1e-4 --resume");
+  ASSERT_EQ(b2.status, 0) << b2.err;
+  // The final snapshot (positions to 9 digits, velocities and forces by kind) and the
+  // removal record agree exactly. (The checkpoint files themselves differ: they also hold
+  // the neighbour list, whose extra non-touching pairs depend on when it was rebuilt.)
+  EXPECT_EQ(io::read_file(d / "a/particles/frame_000002.vtp"), io::read_file(d / "b/particles/frame_000002.vtp"));
+  EXPECT_EQ(io::read_file(d / "a/removals.csv"), io::read_file(d / "b/removals.csv"));
+  // A second plain run into a folder with results is refused; the summary is untouched.
+  const std::string before = io::read_file(d / "a/summary.json");
+  auto c = run_cli("run " + cfg + " --out " + (d / "a").string() + common + " --set run.end_time_s=1e-4");
+  EXPECT_EQ(c.status, 2);
+  EXPECT_NE(c.err.find("already holds results"), std::string::npos) << c.err;
+  EXPECT_EQ(io::read_file(d / "a/summary.json"), before);
+  // A resume with another physical parameter is refused.
+  auto e = run_cli("run " + cfg + " --out " + (d / "b").string() + common + " --set run.end_time_s=2e-4 --resume --set adhesion.cohesion_ratio=3");
+  EXPECT_EQ(e.status, 2);
+  fs::remove_all(d);
+}
