@@ -69,6 +69,12 @@ double crossing(const Prepared& p, std::size_t i0, std::size_t i1, double level,
   return std::nan("");
 }
 
+// sqrt(1 / max(p(1-p), 1/N)) for a model probability p (relative to floor..ceiling).
+double binomial_sqrt_weight(double p, int n_real) {
+  const double v = std::max(p * (1.0 - p), 1.0 / n_real);
+  return 1.0 / std::sqrt(v);
+}
+
 // Parameter layout shared by both models: core parameters first, then ceiling, then floor.
 struct Layout {
   int n_core = 2;
@@ -182,20 +188,33 @@ EdgeFit fit_edge(const std::vector<double>& x_in, const std::vector<double>& c_i
   p0 << x0, w, Eigen::VectorXd::Zero(L.size() - 2);
   if (L.i_ceil >= 0) p0[L.i_ceil] = A0;
   if (L.i_floor >= 0) p0[L.i_floor] = F0;
+  std::vector<double> sw(n, 1.0);  // sqrt of the least-squares weights
   auto model = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
     const double A = L.i_ceil >= 0 ? p[L.i_ceil] : opt.ceiling;
     const double F = L.i_floor >= 0 ? p[L.i_floor] : opt.floor;
     for (std::size_t i = 0; i < n; ++i) {
       const double u = (P.x[i] - p[0]) / p[1];
       const double s = logistic(u), ds = s * (1 - s);
-      r[i] = F + (A - F) * s - P.c[i];
-      J(i, 0) = -(A - F) * ds / p[1];
-      J(i, 1) = -(A - F) * ds * u / p[1];
-      if (L.i_ceil >= 0) J(i, L.i_ceil) = s;
-      if (L.i_floor >= 0) J(i, L.i_floor) = 1 - s;
+      r[i] = sw[i] * (F + (A - F) * s - P.c[i]);
+      J(i, 0) = -sw[i] * (A - F) * ds / p[1];
+      J(i, 1) = -sw[i] * (A - F) * ds * u / p[1];
+      if (L.i_ceil >= 0) J(i, L.i_ceil) = sw[i] * s;
+      if (L.i_floor >= 0) J(i, L.i_floor) = sw[i] * (1 - s);
     }
   };
-  const LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
+  LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
+  for (int pass = 0; pass < (opt.binomial_realizations > 0 ? 3 : 0); ++pass) {
+    for (std::size_t i = 0; i < n; ++i)
+      sw[i] = binomial_sqrt_weight(logistic((P.x[i] - R.p[0]) / R.p[1]), opt.binomial_realizations);
+    R = levenberg_marquardt(model, R.p, n, opt.max_iterations);
+  }
+  for (std::size_t i = 0; i < n; ++i) sw[i] = 1.0;  // report the unweighted rms residual
+  {
+    Eigen::VectorXd r(n);
+    Eigen::MatrixXd J(n, R.p.size());
+    model(R.p, r, J);
+    R.rss = r.squaredNorm();
+  }
   EdgeFit e = make_edge(R.p[0], R.p[1], L.i_floor >= 0 ? R.p[L.i_floor] : opt.floor,
                         L.i_ceil >= 0 ? R.p[L.i_ceil] : opt.ceiling, R.covariance(1, 1), R.covariance(0, 0));
   e.rms_residual = std::sqrt(R.rss / n);
@@ -235,6 +254,7 @@ LineEdgesFit fit_line_edges(const std::vector<double>& x_in, const std::vector<d
   p0.head(4) << xr, wr, xf, wf;
   if (L.i_ceil >= 0) p0[L.i_ceil] = A0;
   if (L.i_floor >= 0) p0[L.i_floor] = F0;
+  std::vector<double> sw(n, 1.0);  // sqrt of the least-squares weights
   auto model = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
     const double A = L.i_ceil >= 0 ? p[L.i_ceil] : opt.ceiling;
     const double F = L.i_floor >= 0 ? p[L.i_floor] : opt.floor;
@@ -243,16 +263,30 @@ LineEdgesFit fit_line_edges(const std::vector<double>& x_in, const std::vector<d
       const double v = -(P.x[i] - p[2]) / p[3];
       const double su = logistic(u), sv = logistic(v);
       const double dsu = su * (1 - su), dsv = sv * (1 - sv);
-      r[i] = F + (A - F) * su * sv - P.c[i];
-      J(i, 0) = -(A - F) * dsu * sv / p[1];
-      J(i, 1) = -(A - F) * dsu * sv * u / p[1];
-      J(i, 2) = (A - F) * su * dsv / p[3];
-      J(i, 3) = -(A - F) * su * dsv * v / p[3];
-      if (L.i_ceil >= 0) J(i, L.i_ceil) = su * sv;
-      if (L.i_floor >= 0) J(i, L.i_floor) = 1 - su * sv;
+      const double k = sw[i] * (A - F);
+      r[i] = sw[i] * (F + (A - F) * su * sv - P.c[i]);
+      J(i, 0) = -k * dsu * sv / p[1];
+      J(i, 1) = -k * dsu * sv * u / p[1];
+      J(i, 2) = k * su * dsv / p[3];
+      J(i, 3) = -k * su * dsv * v / p[3];
+      if (L.i_ceil >= 0) J(i, L.i_ceil) = sw[i] * su * sv;
+      if (L.i_floor >= 0) J(i, L.i_floor) = sw[i] * (1 - su * sv);
     }
   };
-  const LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
+  LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
+  for (int pass = 0; pass < (opt.binomial_realizations > 0 ? 3 : 0); ++pass) {
+    for (std::size_t i = 0; i < n; ++i)
+      sw[i] = binomial_sqrt_weight(logistic((P.x[i] - R.p[0]) / R.p[1]) * logistic(-(P.x[i] - R.p[2]) / R.p[3]),
+                                   opt.binomial_realizations);
+    R = levenberg_marquardt(model, R.p, n, opt.max_iterations);
+  }
+  for (std::size_t i = 0; i < n; ++i) sw[i] = 1.0;  // report the unweighted rms residual
+  {
+    Eigen::VectorXd r(n);
+    Eigen::MatrixXd J(n, R.p.size());
+    model(R.p, r, J);
+    R.rss = r.squaredNorm();
+  }
   LineEdgesFit f;
   f.floor = L.i_floor >= 0 ? R.p[L.i_floor] : opt.floor;
   f.ceiling = L.i_ceil >= 0 ? R.p[L.i_ceil] : opt.ceiling;

@@ -47,6 +47,12 @@ struct SigmoidOptions {
   bool fit_ceiling = true;  // true: the plateau is fitted (maximum coverage scaled to 100 %)
   double ceiling = 1.0;     // used when fit_ceiling is false
   int max_iterations = 200;
+  // > 0: the curve is an average of this many presence/absence realizations, so its noise is
+  // binomial with variance p(1-p)/N. The fit then iterates weighted least squares with weights
+  // 1 / max(p(1-p), 1/N) from the previous pass (3 reweighting passes), which is the maximum-
+  // likelihood fit and ~1.5x more precise on the narrow edge than unweighted least squares.
+  // The floor 1/N keeps a single stray particle far in the tail from dominating.
+  int binomial_realizations = 0;
 };
 
 struct EdgeFit {

@@ -38,10 +38,12 @@ SteadyState detect_steady_state(const std::vector<double>& t, const std::vector<
     Y[k] /= static_cast<double>(b);
   }
 
-  // MSER over d = 0 .. nb - 5 (keep at least 5 batches for the statistic).
+  // MSER over d = 0 .. max_truncation_fraction * nb (searching further lets a short, by chance
+  // quiet tail win; a transient that lasts longer is caught by the drift test below).
+  const std::size_t d_max = std::min(nb - 5, static_cast<std::size_t>(std::floor(opt.max_truncation_fraction * nb)));
   std::size_t best_d = 0;
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t d = 0; d + 5 <= nb; ++d) {
+  for (std::size_t d = 0; d <= d_max; ++d) {
     const double m = static_cast<double>(nb - d);
     double mean = 0;
     for (std::size_t k = d; k < nb; ++k) mean += Y[k];
@@ -56,12 +58,6 @@ SteadyState detect_steady_state(const std::vector<double>& t, const std::vector<
   }
   s.onset_index = best_d == 0 ? 0 : skip + best_d * b;
   s.t_onset = t[s.onset_index];
-  if (static_cast<double>(best_d) > opt.max_truncation_fraction * static_cast<double>(nb)) {
-    s.reason = fmt::format(
-        "still drifting: the MSER truncation point t = {:g} lies beyond {:.0f}% of the signal (the transient has not ended)",
-        s.t_onset, 100 * opt.max_truncation_fraction);
-    return s;
-  }
 
   // Drift test between the halves of the retained batches.
   const std::size_t kept = nb - best_d, h = kept / 2;
@@ -100,9 +96,10 @@ SteadyState detect_steady_state(const std::vector<double>& t, const std::vector<
 
   const bool within_tol = opt.drift_tolerance > 0 && std::abs(s.drift) <= opt.drift_tolerance;
   if (s.drift_z > opt.z_threshold && !within_tol) {
-    s.reason = fmt::format("still drifting: mean changed by {:g} between the halves of the retained part ({:.1f} standard "
-                           "errors > {:g})",
-                           s.drift, s.drift_z, opt.z_threshold);
+    s.reason = fmt::format("still drifting: mean changed by {:g} between the halves of the part after t = {:g} ({:.1f} "
+                           "standard errors > {:g}){}",
+                           s.drift, s.t_onset, s.drift_z, opt.z_threshold,
+                           best_d == d_max ? "; the transient may not have ended (onset at the search limit)" : "");
     return s;
   }
   s.steady = true;

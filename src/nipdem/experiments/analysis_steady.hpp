@@ -6,9 +6,9 @@
 //  1. The signal is cut into `n_batches` equal batches (dropping the first n mod n_batches
 //     samples) and reduced to batch means, which are far less autocorrelated than raw samples.
 //  2. MSER truncation (White 1997) on the batch means: choose the number d of leading batches
-//     to discard that minimises  sum_{i>=d} (Y_i - mean_d)^2 / (nb - d)^2 . If the best d
-//     lies beyond `max_truncation_fraction` of the signal, the transient has not ended:
-//     not steady.
+//     to discard that minimises  sum_{i>=d} (Y_i - mean_d)^2 / (nb - d)^2 , searching d up to
+//     `max_truncation_fraction` of the batches (further, a short tail that is quiet by chance
+//     would win).
 //  3. Drift test on the retained batches: the means of their first and second halves must
 //     agree within `z_threshold` standard errors (pooled batch-mean variance), or within the
 //     absolute `drift_tolerance` if one is given.
