@@ -206,3 +206,33 @@ TEST(AnalysisSigmoid, BadInputIsAnInputError) {
   EXPECT_THROW(average_curve({{0, 1}, {0, 1, 1}}), InputError);
   EXPECT_THROW(average_curve({}), InputError);
 }
+
+#include <filesystem>
+
+#include "nipdem/experiments/analysis_report.hpp"
+#include "nipdem/io/csv.hpp"
+
+TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {
+  // CLI.md keys for `experiment edge-sharpness`; values equal the fit's widths.
+  const TrueLine L;
+  const auto x = grid(-400e-6, 1000e-6, 4e-6);
+  Rng rng(8);
+  std::vector<std::vector<double>> real(20, std::vector<double>(x.size()));
+  for (auto& r : real)
+    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  const auto b = bootstrap_line_edges(x, real, 20, 1);
+  const auto j = edge_sharpness_json(b, real.size());
+  EXPECT_EQ(j.at("edge_front_m").get<double>(), b.fit.front.width_10_90);
+  EXPECT_EQ(j.at("edge_back_m").get<double>(), b.fit.back.width_10_90);
+  EXPECT_EQ(j.at("edge_front_ci_m").size(), 2u);
+  EXPECT_EQ(j.at("edge_back_ci_m")[1].get<double>(), b.back_width_ci.hi);
+  EXPECT_EQ(j.at("realizations").get<int>(), 20);
+  const auto dir = std::filesystem::temp_directory_path() / ("nipdem_report_" + std::to_string(::getpid()));
+  write_coverage_csv(dir / "coverage.csv", x, b.average, b.fit);
+  const auto t = io::read_csv(dir / "coverage.csv");
+  EXPECT_EQ(t.columns, (std::vector<std::string>{"x_m", "coverage", "fit"}));
+  EXPECT_EQ(t.column("coverage"), b.average);
+  io::write_plot_png(dir / "coverage.png", coverage_plot(x, b.average, b.fit, "edge sharpness"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "coverage.png"));
+  std::filesystem::remove_all(dir);
+}

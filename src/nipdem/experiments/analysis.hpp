@@ -4,3 +4,4 @@
 #include "nipdem/experiments/analysis_reduction.hpp"
 #include "nipdem/experiments/analysis_steady.hpp"
 #include "nipdem/experiments/analysis_vo.hpp"
+#include "nipdem/experiments/analysis_report.hpp"
