@@ -33,6 +33,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       nlohmann::json j{{"restitution", r.restitution},
                        {"restitution_no_drag", r.restitution_no_drag},
                        {"reynolds_at_impact", r.reynolds_at_impact},
+                       {"restitution_schiller_naumann", r.restitution_schiller_naumann},
                        {"impact_speed_m_per_s", r.impact_speed_m_per_s},
                        {"impact_speed_no_drag_m_per_s", r.impact_speed_no_drag_m_per_s},
                        {"rebound_speed_m_per_s", r.rebound_speed_m_per_s},
@@ -55,6 +56,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
                   o->p.y0_m, o->p.y1_m, o->p.radius_m, o->p.density_kg_per_m3, o->p.viscosity_Pa_s);
       std::printf("  restitution (Stokes drag, eq. 4.2.4-4.2.6) %.6f\n", r.restitution);
       std::printf("  restitution (no drag, eq. 4.2.2)           %.6f\n", r.restitution_no_drag);
+      std::printf("  restitution (Schiller-Naumann drag, check)  %.6f\n", r.restitution_schiller_naumann);
       std::printf("  impact speed                                %.6g m/s (no drag %.6g m/s)\n", r.impact_speed_m_per_s,
                   r.impact_speed_no_drag_m_per_s);
       std::printf("  rebound speed                               %.6g m/s\n", r.rebound_speed_m_per_s);

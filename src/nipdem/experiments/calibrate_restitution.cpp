@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
+#include <stdexcept>
 
 #include "nipdem/core/error.hpp"
 
@@ -60,7 +61,65 @@ double solve_increasing(F f, DF df, double target, double z0) {
   return z;
 }
 
+struct YV {
+  double y, v;
+};
+
+double drag_factor(const DragModel& d, double speed) {
+  if (!d.schiller_naumann) return 1.0;
+  const double re = d.air_density_kg_per_m3 * speed * 2.0 * d.radius_m / d.viscosity_Pa_s;
+  return 1.0 + 0.15 * std::pow(re, 0.687);
+}
+
+YV rk4(const DragModel& d, YV s, double h) {
+  const double c = 6.0 * constants::pi * d.viscosity_Pa_s * d.radius_m / d.mass_kg;
+  auto f = [&](YV q) { return YV{q.v, -d.gravity_m_per_s2 - c * drag_factor(d, std::abs(q.v)) * q.v}; };
+  const YV k1 = f(s);
+  const YV k2 = f({s.y + 0.5 * h * k1.y, s.v + 0.5 * h * k1.v});
+  const YV k3 = f({s.y + 0.5 * h * k2.y, s.v + 0.5 * h * k2.v});
+  const YV k4 = f({s.y + h * k3.y, s.v + h * k3.v});
+  return {s.y + h / 6 * (k1.y + 2 * k2.y + 2 * k3.y + k4.y), s.v + h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v)};
+}
+
+// Step size: resolves both the flight time and the Stokes relaxation time.
+double step_for(const DragModel& d, double height) {
+  const double beta = d.mass_kg / (6.0 * constants::pi * d.viscosity_Pa_s * d.radius_m);
+  const double g = d.gravity_m_per_s2;
+  const double T = std::max(std::sqrt(2.0 * height / g), height / (beta * g));
+  return std::min(beta / 20.0, T / 4000.0);
+}
+
+// Integrates until event(state) <= 0 and returns the state at the event (bisected step).
+template <class Ev>
+YV integrate_to(const DragModel& d, YV s, double dt, Ev event) {
+  for (long n = 0; n < 100000000L; ++n) {
+    const YV next = rk4(d, s, dt);
+    if (event(next) <= 0) {
+      double lo = 0, hi = dt;
+      for (int i = 0; i < 100; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (event(rk4(d, s, mid)) > 0) lo = mid;
+        else hi = mid;
+      }
+      return rk4(d, s, 0.5 * (lo + hi));
+    }
+    s = next;
+  }
+  throw std::runtime_error("drop test integration did not reach its event");
+}
+
 }  // namespace
+
+double fall_speed_numeric(const DragModel& d, double y0) {
+  const YV impact = integrate_to(d, {y0, 0.0}, step_for(d, y0), [](YV s) { return s.y; });
+  return -impact.v;
+}
+
+double rise_height_numeric(const DragModel& d, double v_up) {
+  if (v_up <= 0) return 0.0;
+  const double h_est = v_up * v_up / (2.0 * d.gravity_m_per_s2);
+  return integrate_to(d, {0.0, v_up}, step_for(d, h_est), [](YV s) { return s.v; }).y;
+}
 
 DropTestResult drop_test_restitution(const DropTestParams& p) {
   const std::string where = "calibrate restitution";
@@ -105,6 +164,19 @@ DropTestResult drop_test_restitution(const DropTestParams& p) {
                 fmt::format("with Stokes drag this rebound needs e_n = {:.4f} > 1 (energy gain); check y0, y1 and the "
                             "drag parameters",
                             r.restitution));
+  // Schiller–Naumann cross-check: solve rise_height(v_f) = y1 for v_f by bisection.
+  {
+    const DragModel d{r.mass_kg, p.radius_m, p.viscosity_Pa_s, p.air_density_kg_per_m3, g, true};
+    const double vi = fall_speed_numeric(d, p.y0_m);
+    double lo = 0.0, hi = std::sqrt(2.0 * g * p.y1_m);
+    while (rise_height_numeric(d, hi) < p.y1_m) hi *= 2.0;
+    for (int i = 0; i < 60 && hi - lo > 1e-13 * hi; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (rise_height_numeric(d, mid) < p.y1_m) lo = mid;
+      else hi = mid;
+    }
+    r.restitution_schiller_naumann = 0.5 * (lo + hi) / vi;
+  }
   return r;
 }
 

@@ -45,7 +45,21 @@ struct DropTestResult {
   double rise_time_s = 0;                 // from impact to the top of the rebound
   double terminal_speed_m_per_s = 0;      // beta g
   double reynolds_at_impact = 0;
+  // Cross-check beyond the thesis: the same drop test with the Schiller–Naumann drag
+  // F = 6 pi eta R v (1 + 0.15 Re^0.687) (valid for Re < ~800), integrated numerically (RK4 with
+  // bisected events), since Re at impact is far outside the Stokes range.
+  double restitution_schiller_naumann = 0;
 };
+
+// Height reached by a sphere launched upward at `v_up` [m/s] (or the speed after falling
+// from `y0` at rest, for fall_speed_numeric) with a drag force law given as a factor f(Re)
+// multiplying the Stokes drag (f = 1: Stokes). Exposed for tests; RK4 with bisected events.
+struct DragModel {
+  double mass_kg, radius_m, viscosity_Pa_s, air_density_kg_per_m3, gravity_m_per_s2;
+  bool schiller_naumann = false;
+};
+double fall_speed_numeric(const DragModel& d, double y0_m);
+double rise_height_numeric(const DragModel& d, double v_up_m_per_s);
 
 // Validates the parameters (InputError naming key, value and allowed range; y1 > y0 and a
 // result e_n > 1 are rejected as unphysical input) and solves the drop test.
