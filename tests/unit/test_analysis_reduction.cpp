@@ -45,6 +45,10 @@ TEST(AnalysisReduction, ScriptedStreamGivesExactCountsAndSpeed) {
   EXPECT_EQ(counter.count(10 * dt, 20 * dt), 10u);
   EXPECT_EQ(counter.count(0.0, 1.0), 101u);
   EXPECT_EQ(counter.count(3.6 * dt, 3.4 * dt), 0u);
+  // Filter on where: removed x run from 399 d down to 299 d, so x >= 200 d selects all 101
+  // and x >= 350 d the first 50.
+  EXPECT_EQ(counter.count(0.0, 1.0, [&](const RemovalEvent& e) { return e.where.x >= 200 * d - 1e-12; }), 101u);
+  EXPECT_EQ(counter.count(0.0, 1.0, [&](const RemovalEvent& e) { return e.where.x >= 350 * d - 1e-12; }), 50u);
   const auto h = counter.histogram(0.0, 25 * dt, 5);
   EXPECT_EQ(h, (std::vector<std::size_t>{25, 25, 25, 25, 1}));
 
@@ -94,6 +98,8 @@ TEST(AnalysisReduction, BadInput) {
   EXPECT_THROW(assembly_extent(0.0, {1.0, 2.0}, {FrontAt::min_x, 1, 0.0}), InputError);
   EXPECT_THROW(assembly_extent(0.0, {}), InputError);
   EXPECT_THROW(linear_fit({1, 1, 1}, {1, 2, 3}), InputError);
+  EXPECT_THROW(assembly_extents({0.0, 1.0}, {{1.0}}), InputError);
+  EXPECT_EQ(assembly_extents({0.0, 1.0}, {{1.0, 3.0}, {2.0, 3.0}})[1].size, 1.0);
   EXPECT_THROW(linear_fit({1, 2}, {1, 2}), InputError);
   RemovalCounter c;
   EXPECT_THROW(c.histogram(0, 0, 3), InputError);

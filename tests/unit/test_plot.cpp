@@ -208,7 +208,7 @@ TEST(AnalysisCsv, ErrorsNameFileLineAndColumn) {
   EXPECT_NE(ragged.find("2 cells"), std::string::npos) << ragged;
   const std::string nonnum = msg("frequency_Hz,amplitude_V,phase_deg\n1,2,3\n4,five,6\n");
   EXPECT_NE(nonnum.find("data.csv:3"), std::string::npos) << nonnum;
-  EXPECT_NE(nonnum.find("column 2 'amplitude_V'"), std::string::npos) << nonnum;
+  EXPECT_NE(nonnum.find("'amplitude_V (column 2)'"), std::string::npos) << nonnum;
   EXPECT_NE(nonnum.find("'five'"), std::string::npos) << nonnum;
   EXPECT_NE(msg("a,b\n1,2x\n").find("not a number"), std::string::npos);
   EXPECT_NE(msg("a,b\n1,\n").find("not a number"), std::string::npos);

@@ -15,6 +15,13 @@ std::size_t RemovalCounter::count(double t0, double t1) const {
   return c;
 }
 
+std::size_t RemovalCounter::count(double t0, double t1, const std::function<bool(const RemovalEvent&)>& select) const {
+  std::size_t c = 0;
+  for (const auto& e : events_)
+    if (e.t >= t0 && e.t < t1 && select(e)) ++c;
+  return c;
+}
+
 std::vector<std::size_t> RemovalCounter::histogram(double t0, double dt, std::size_t n) const {
   require_positive("removal histogram", "dt", dt);
   std::vector<std::size_t> h(n, 0);
@@ -48,6 +55,16 @@ Extent assembly_extent(double t, const std::vector<double>& x, const ExtentOptio
   e.size = hi - lo;
   e.n = s.size() - 2 * k;
   return e;
+}
+
+std::vector<Extent> assembly_extents(const std::vector<double>& t, const std::vector<std::vector<double>>& x,
+                                     const ExtentOptions& opt) {
+  if (t.size() != x.size())
+    throw_input("assembly extent", "frames", fmt::format("{} times, {} frames", t.size(), x.size()), "counts differ");
+  std::vector<Extent> out;
+  out.reserve(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k) out.push_back(assembly_extent(t[k], x[k], opt));
+  return out;
 }
 
 LinearFit linear_fit(const std::vector<double>& x, const std::vector<double>& y) {

@@ -8,6 +8,7 @@
 // assembly but are still tracked), so a few outliers do not move front or back.
 #pragma once
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,8 @@ class RemovalCounter {
   void record(const RemovalEvent& e) { events_.push_back(e); }
   // Number of events with t0 <= t < t1.
   std::size_t count(double t0, double t1) const;
+  // Same, only events for which `select` is true (e.g. removed past a given x).
+  std::size_t count(double t0, double t1, const std::function<bool(const RemovalEvent&)>& select) const;
   // Counts in consecutive windows [t0 + k dt, t0 + (k+1) dt), k = 0 .. n-1.
   std::vector<std::size_t> histogram(double t0, double dt, std::size_t n) const;
   const std::vector<RemovalEvent>& events() const { return events_; }
@@ -56,6 +59,9 @@ struct Extent {
 // Front/back/size from particle x positions at time t. Throws InputError if, after trimming,
 // no particle is left.
 Extent assembly_extent(double t, const std::vector<double>& x, const ExtentOptions& opt = {});
+// One Extent per frame: x_per_frame[k] are the particle x positions at time t[k].
+std::vector<Extent> assembly_extents(const std::vector<double>& t, const std::vector<std::vector<double>>& x_per_frame,
+                                     const ExtentOptions& opt = {});
 
 // ---- Least squares line ------------------------------------------------------------------
 struct LinearFit {

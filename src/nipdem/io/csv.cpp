@@ -141,7 +141,7 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
         if (!c.empty() && *b == '+') ++b;  // from_chars rejects a leading '+'
         const auto res = std::from_chars(b, e, v);
         if (c.empty() || res.ec != std::errc() || res.ptr != e)
-          throw InputError(input_message(where, fmt::format("column {} '{}'", j + 1, t.columns[j]),
+          throw InputError(input_message(where, fmt::format("{} (column {})", t.columns[j], j + 1),
                                          "'" + std::string(c) + "'", "not a number"));
         row[j] = v;
       }
