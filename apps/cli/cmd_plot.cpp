@@ -1,6 +1,7 @@
 // `nipdem plot DATA.csv --x COL --y COL[,COL...] --out FILE.png`: quick PNG of CSV columns
 // (front position vs gap, coverage curves, reduction counts vs r ...). Column names are the
 // CSV header names (with their unit suffix); axis labels default to them.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@ struct Opts {
   std::vector<std::string> y, yerr;
   bool logx = false, logy = false, markers = false, no_lines = false, json = false;
   int width = 800, height = 560;
+  double xscale = 1.0, yscale = 1.0;
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
@@ -30,6 +32,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--title", o->title, "plot title");
   sub->add_option("--xlabel", o->xlabel, "x axis label with unit (default: the column name)");
   sub->add_option("--ylabel", o->ylabel, "y axis label with unit (default: the first y column)");
+  sub->add_option("--xscale", o->xscale, "multiply x values (e.g. 1e6 to show metres as µm)")->capture_default_str();
+  sub->add_option("--yscale", o->yscale, "multiply y values and error bars")->capture_default_str();
   sub->add_flag("--logx", o->logx, "logarithmic x axis");
   sub->add_flag("--logy", o->logy, "logarithmic y axis");
   sub->add_flag("--markers", o->markers, "draw markers");
@@ -50,13 +54,16 @@ nipdem::cli::Register reg([](CLI::App& app) {
     p.log_y = o->logy;
     p.width = o->width;
     p.height = o->height;
-    const auto x = t.column(o->x);
+    auto x = t.column(o->x);
+    for (double& v : x) v *= o->xscale;
     for (std::size_t k = 0; k < o->y.size(); ++k) {
       nipdem::io::Series s;
       s.label = o->y.size() > 1 || !o->yerr.empty() ? o->y[k] : "";
       s.x = x;
       s.y = t.column(o->y[k]);
+      for (double& v : s.y) v *= o->yscale;
       if (!o->yerr.empty()) s.y_err = t.column(o->yerr[k]);
+      for (double& v : s.y_err) v *= std::abs(o->yscale);
       s.markers = o->markers || o->no_lines;
       s.line = !o->no_lines;
       p.series.push_back(std::move(s));

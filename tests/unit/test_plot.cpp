@@ -58,6 +58,9 @@ TEST(AnalysisPlot, NiceTicks) {
   EXPECT_EQ(io::tick_label(0.25, 0.05), "0.25");
   EXPECT_EQ(io::tick_label(150, 50), "150");
   EXPECT_EQ(io::tick_label(2e-6, 1e-6), "2e-06");
+  EXPECT_EQ(io::tick_labels({-2.5e-4, -2e-4, -1.5e-4}, false), (std::vector<std::string>{"-2.5e-4", "-2.0e-4", "-1.5e-4"}));
+  EXPECT_EQ(io::tick_labels({0, 0.5, 1.0}, false), (std::vector<std::string>{"0", "0.5", "1.0"}));
+  EXPECT_EQ(io::tick_labels({1, 10, 100}, true), (std::vector<std::string>{"1", "10", "100"}));
 }
 
 TEST(AnalysisPlot, PngHasRequestedSizeAndDrawsSeries) {

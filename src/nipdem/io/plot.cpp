@@ -142,6 +142,34 @@ std::string tick_label(double v, double step) {
   return fmt::format("{:.{}f}", v, dec);
 }
 
+std::vector<std::string> tick_labels(const std::vector<double>& ticks, bool log) {
+  std::vector<std::string> out;
+  if (log || ticks.size() < 2) {
+    for (double v : ticks) out.push_back(fmt::format("{:g}", v));
+    return out;
+  }
+  const double step = ticks[1] - ticks[0];
+  double amax = 0;
+  for (double v : ticks) amax = std::max(amax, std::abs(v));
+  if (step >= 1e-3 && amax < 1e5) {
+    for (double v : ticks) out.push_back(tick_label(v, step));
+    return out;
+  }
+  // Very small or very large values: one common exponent, same mantissa decimals on the axis
+  // ("-1.5e-4", "-2.0e-4", ...).
+  const int e = static_cast<int>(std::floor(std::log10(amax)));
+  const double scale = std::pow(10.0, e);
+  const double ms = step / scale;
+  int dec = std::max(0, static_cast<int>(std::ceil(-std::log10(ms) - 1e-9)));
+  if (std::abs(ms * std::pow(10.0, dec) - std::round(ms * std::pow(10.0, dec))) > 1e-6) ++dec;
+  dec = std::min(dec, 8);
+  for (double v : ticks) {
+    if (std::abs(v) < 1e-9 * step) out.push_back("0");
+    else out.push_back(fmt::format("{:.{}f}e{}", v / scale, dec, e));
+  }
+  return out;
+}
+
 void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
   const std::string where = "plot '" + path.string() + "'";
   if (spec.width < 100 || spec.height < 100 || spec.width > 10000 || spec.height > 10000)
@@ -199,11 +227,10 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
   // Ticks and their labels (needed to size the left margin).
   std::vector<double> xt = ax.log ? log_ticks(ax.lo, ax.hi) : nice_ticks(ax.lo, ax.hi, 6);
   std::vector<double> yt = ay.log ? log_ticks(ay.lo, ay.hi) : nice_ticks(ay.lo, ay.hi, 6);
-  const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 0.0;
-  const double ystep = yt.size() > 1 ? yt[1] - yt[0] : 0.0;
   cairo_set_font_size(cr, fs * 0.85);
   double ylabel_w = 0;
-  for (double v : yt) ylabel_w = std::max(ylabel_w, text_width(cr, tick_label(v, ay.log ? v : ystep)));
+  const std::vector<std::string> xlab = tick_labels(xt, ax.log), ylab = tick_labels(yt, ay.log);
+  for (const auto& l : ylab) ylabel_w = std::max(ylabel_w, text_width(cr, l));
 
   const double left = 0.9 * fs + ylabel_w + fs * 1.8;
   const double right = fs * 1.5;
@@ -217,7 +244,8 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
 
   // Grid and ticks.
   cairo_set_line_width(cr, 1.0);
-  for (double v : xt) {
+  for (std::size_t k = 0; k < xt.size(); ++k) {
+    const double v = xt[k];
     const double X = std::round(px(v)) + 0.5;
     cairo_set_source_rgb(cr, 0.9, 0.9, 0.9);
     cairo_move_to(cr, X, top);
@@ -227,9 +255,10 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
     cairo_move_to(cr, X, top + ph);
     cairo_line_to(cr, X, top + ph + fs * 0.35);
     cairo_stroke(cr);
-    show_text_at(cr, tick_label(v, ax.log ? v : xstep), X, top + ph + fs * 0.45, 0.5, 0.0);
+    show_text_at(cr, xlab[k], X, top + ph + fs * 0.45, 0.5, 0.0);
   }
-  for (double v : yt) {
+  for (std::size_t k = 0; k < yt.size(); ++k) {
+    const double v = yt[k];
     const double Y = std::round(py(v)) + 0.5;
     cairo_set_source_rgb(cr, 0.9, 0.9, 0.9);
     cairo_move_to(cr, left, Y);
@@ -239,7 +268,7 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
     cairo_move_to(cr, left - fs * 0.35, Y);
     cairo_line_to(cr, left, Y);
     cairo_stroke(cr);
-    show_text_at(cr, tick_label(v, ay.log ? v : ystep), left - fs * 0.5, Y, 1.0, 0.5);
+    show_text_at(cr, ylab[k], left - fs * 0.5, Y, 1.0, 0.5);
   }
   // Frame.
   cairo_set_source_rgb(cr, 0, 0, 0);
@@ -330,7 +359,28 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
     for (auto s : shown) tw = std::max(tw, text_width(cr, spec.series[s].label));
     const double row = fs * 1.25, sample = fs * 2.0, pad = fs * 0.5;
     const double bw = pad * 3 + sample + tw, bh = pad * 2 + row * shown.size();
-    const double bx = left + pw - bw - pad, by = top + pad;
+    // Corner of the plot area that hides the fewest data points (top right on ties).
+    const std::array<std::array<double, 2>, 4> corners{{{left + pw - bw - pad, top + pad},
+                                                         {left + pad, top + pad},
+                                                         {left + pw - bw - pad, top + ph - bh - pad},
+                                                         {left + pad, top + ph - bh - pad}}};
+    std::size_t best = 0, best_n = std::numeric_limits<std::size_t>::max();
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+      std::size_t n = 0;
+      for (const Series& se : spec.series)
+        for (std::size_t i = 0; i < se.x.size(); ++i) {
+          if (!std::isfinite(se.x[i]) || !std::isfinite(se.y[i])) continue;
+          const double X = px(se.x[i]), Y = py(se.y[i]);
+          if (X >= corners[k][0] - pad && X <= corners[k][0] + bw + pad && Y >= corners[k][1] - pad &&
+              Y <= corners[k][1] + bh + pad)
+            ++n;
+        }
+      if (n < best_n) {
+        best_n = n;
+        best = k;
+      }
+    }
+    const double bx = corners[best][0], by = corners[best][1];
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
     cairo_rectangle(cr, bx, by, bw, bh);
     cairo_fill_preserve(cr);

@@ -1,6 +1,6 @@
 // Small Cairo PNG plots of XY data for experiment reports: several series (lines and/or
 // markers, optional vertical error bars), axes with "nice" ticks, labels with units,
-// title, legend, optional log axes.
+// title, legend (placed in the corner hiding the fewest points), optional log axes.
 //
 // Example (front position vs gap):
 //   io::PlotSpec p;
@@ -61,5 +61,8 @@ std::vector<double> nice_ticks(double lo, double hi, int target = 6);
 std::vector<double> log_ticks(double lo, double hi);
 // Tick label text: shortest readable form ("0.25", "1e-06", "150").
 std::string tick_label(double v, double step);
+// Labels for a whole axis, consistent in format: fixed decimals for ordinary ranges, one
+// common exponent ("-1.5e-4", "-2.0e-4") for tiny or huge values, "%g" on log axes.
+std::vector<std::string> tick_labels(const std::vector<double>& ticks, bool log);
 
 }  // namespace nipdem::io
