@@ -1,0 +1,36 @@
+// JSON / CSV / PNG output of the analysis results, with the key names of CLI.md
+// (snake_case, SI unit suffix). Kept apart from the numerics so those stay I/O-free.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/experiments/analysis_reduction.hpp"
+#include "nipdem/experiments/analysis_steady.hpp"
+#include "nipdem/experiments/analysis_vo.hpp"
+#include "nipdem/io/plot.hpp"
+
+namespace nipdem::analysis {
+
+// Edge sharpness (CLI.md `experiment edge-sharpness`): "edge_front_m", "edge_back_m" (10–90 %
+// widths), "edge_front_ci_m"/"edge_back_ci_m" ([lo, hi] bootstrap percentile intervals),
+// "edge_front_std_m"/"edge_back_std_m", "confidence_level", "bootstrap_resamples",
+// "bootstrap_failed", "realizations" (if > 0), and "fit" (positions, floor, ceiling, rms).
+// x is in metres.
+nlohmann::json edge_sharpness_json(const LineEdgesBootstrap& b, std::size_t realizations = 0);
+nlohmann::json to_json(const EdgeFit& f);            // x0_m, w_m, width_10_90_m, ... 
+nlohmann::json to_json(const SteadyState& s);        // steady, reason, value, std, stderr, t_onset_s, ...
+nlohmann::json to_json(const ReductionSpeed& r);     // reduction_speed_m_per_s, ..._stderr, ...
+nlohmann::json to_json(const VoStatistics& v);       // vo_mean_V, vo_std_V, vo_stderr_V, vo_per_seed_V, ...
+
+// Coverage curve file: columns x_m, coverage, fit (the fitted model at x). Atomic write.
+void write_coverage_csv(const std::filesystem::path& path, const std::vector<double>& x_m,
+                        const std::vector<double>& coverage, const LineEdgesFit& fit);
+// Plot of an average coverage curve with its fit (x shown in µm), as in thesis fig. 1.8.
+io::PlotSpec coverage_plot(const std::vector<double>& x_m, const std::vector<double>& coverage,
+                           const LineEdgesFit& fit, const std::string& title);
+
+}  // namespace nipdem::analysis
