@@ -35,7 +35,7 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
   }
   NipRun run(cfg);
   std::vector<std::pair<double, std::string>> frames;
-  std::string series = "time_s,bodies,discs,inserted,developed,returned,lost,contacts,kinetic_energy_J\n";
+  std::string series = "time_s,bodies,discs,inserted,developed,returned,lost,contacts,kinetic_energy_J,drum_voltage_V,printable,charged_over_1V,max_voltage_V\n";
   if (opt.resume) {
     run.restore(io::read_file(ckpt));
     if (fs::exists(out / "frames.json")) {
@@ -68,9 +68,16 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
       for (auto& [t, f] : frames) fj.push_back({t, f});
       io::write_file_atomic(out / "frames.json", fj.dump());
     }
-    series += fmt::format("{:.9g},{},{},{},{},{},{},{},{:.6g}\n", sim.time(), sim.bodies().x.size(), sim.discs().x.size(), run.inserted(),
-                          run.removed(Exit::developed), run.removed(Exit::returned), run.removed(Exit::lost), sim.contacts(),
-                          sim.energy().kinetic);
+    double vd = 0, vmax = 0;
+    int printable = 0, charged = 0;
+    if (const auto* e = run.electric()) {
+      vd = e->drum_voltage();
+      printable = e->printable_count();
+      for (double u : e->voltage()) { vmax = std::max(vmax, std::fabs(u)); charged += std::fabs(u) > 1.0; }
+    }
+    series += fmt::format("{:.9g},{},{},{},{},{},{},{},{:.6g},{:g},{},{},{:.4g}\n", sim.time(), sim.bodies().x.size(), sim.discs().x.size(),
+                          run.inserted(), run.removed(Exit::developed), run.removed(Exit::returned), run.removed(Exit::lost),
+                          sim.contacts(), sim.energy().kinetic, vd, printable, charged, vmax);
     io::write_file_atomic(out / "timeseries.csv", series);
   };
   auto save_checkpoint = [&] {
