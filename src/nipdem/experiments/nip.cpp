@@ -60,6 +60,47 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   if (cfg_.prefill) prefill();
 }
 
+bool NipRun::place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega) {
+  // member centres about the mass centre (the engine recentres the offsets the same way)
+  double m = 0;
+  Vec2 com{};
+  for (std::size_t k = 0; k < spec.radii.size(); ++k) {
+    const double mk = std::pow(spec.radii[k], 3);
+    m += mk;
+    com += mk * spec.offsets[k];
+  }
+  com /= m;
+  std::vector<Vec2> pts;
+  double extent = 0.0;
+  for (std::size_t k = 0; k < spec.offsets.size(); ++k) {
+    pts.push_back(pos + rotate(spec.offsets[k] - com, angle));
+    extent = std::max(extent, norm(spec.offsets[k] - com) + spec.radii[k]);
+  }
+  // overlap with the drum and the roller (base circle; pits lie below it)
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    if (norm(pts[k] - drum_centre()) < cfg_.drum_radius + spec.radii[k]) return false;
+    if (norm(pts[k] - roller_centre()) < cfg_.roller_radius + spec.radii[k]) return false;
+  }
+  const auto& dd = sim_->discs();
+  const double reach = 2.0 * extent + cfg_.size.d_max();
+  for (std::size_t i = 0; i < dd.x.size(); ++i) {
+    if (std::fabs(dd.x[i] - pos.x) > reach || std::fabs(dd.y[i] - pos.y) > reach) continue;
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const double rr = dd.r[i] + spec.radii[k];
+      const double dx = dd.x[i] - pts[k].x, dy = dd.y[i] - pts[k].y;
+      if (dx * dx + dy * dy < rr * rr) return false;
+    }
+  }
+  spec.position = pos;
+  spec.angle = angle;
+  spec.velocity = velocity;
+  spec.omega = omega;
+  spec.tag = 0;
+  sim_->add_body(spec);
+  ++inserted_;
+  return true;
+}
+
 bool NipRun::try_insert(double x_lo, double x_hi) {
   const double d = cfg_.size.sample(rng_);
   engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
@@ -71,46 +112,48 @@ bool NipRun::try_insert(double x_lo, double x_hi) {
   const double ytop = drum_surface_y(x) - extent - 1e-8;
   const double ybot = std::max(drum_surface_y(x) - cfg_.layer_thickness + extent, roller_surface_y(x) + extent + 1e-8);
   if (ytop < ybot) return false;
-  const double y = rng_.uniform(ybot, ytop);
-  // world discs of the candidate (offsets are about an arbitrary origin; use the COM shift)
-  double m = 0;
-  Vec2 com{};
-  for (std::size_t k = 0; k < spec.radii.size(); ++k) {
-    const double mk = std::pow(spec.radii[k], 3);
-    m += mk;
-    com += mk * spec.offsets[k];
-  }
-  com /= m;
-  const Vec2 pos{x, y};
-  std::vector<Vec2> pts;
-  for (auto& o : spec.offsets) pts.push_back(pos + rotate(o - com, angle));
-  // overlap with walls (roughness pits are below the base circle: the base test suffices)
-  for (std::size_t k = 0; k < pts.size(); ++k) {
-    if (norm(pts[k] - drum_centre()) < cfg_.drum_radius + spec.radii[k]) return false;
-    if (norm(pts[k] - roller_centre()) < cfg_.roller_radius + spec.radii[k]) return false;
-  }
-  // overlap with existing discs nearby
-  const auto& dd = sim_->discs();
-  const double reach = x_hi - x_lo + 2.0 * extent + cfg_.size.d_max();
-  for (std::size_t i = 0; i < dd.x.size(); ++i) {
-    if (std::fabs(dd.x[i] - x) > reach) continue;
-    for (std::size_t k = 0; k < pts.size(); ++k) {
-      const double rr = dd.r[i] + spec.radii[k];
-      const double dx = dd.x[i] - pts[k].x, dy = dd.y[i] - pts[k].y;
-      if (dx * dx + dy * dy < rr * rr) return false;
+  const Vec2 pos{x, rng_.uniform(ybot, ytop)};
+  // moving with the drum surface (rigid rotation about the drum axis)
+  const auto& drum = sim_->walls()[1];
+  return place(spec, pos, angle, cross(drum.omega, pos - drum.centre), drum.omega);
+}
+
+bool NipRun::try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi) {
+  const double d = cfg_.size.sample(rng_);
+  engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
+  const double angle = rng_.uniform(0.0, 2.0 * pi);
+  double extent = 0.0;
+  for (std::size_t k = 0; k < spec.radii.size(); ++k) extent = std::max(extent, norm(spec.offsets[k]) + spec.radii[k]);
+  const double x = rng_.uniform(x_lo, x_hi);
+  const double ybot = roller_surface_y(x) + std::max(h_lo, 0.0) + extent + 1e-8;
+  const double ytop = std::min(roller_surface_y(x) + h_hi - extent, drum_surface_y(x) - extent - 1e-8);
+  if (ytop < ybot) return false;
+  return place(spec, {x, rng_.uniform(ybot, ytop)}, angle, {0.0, 0.0}, 0.0);
+}
+
+int NipRun::fill_on_roller(double x0, double x1, double h0, double h1, double area_fraction) {
+  double area = (x1 - x0) * (h1 - h0) * area_fraction;
+  int n = 0, failures = 0;
+  while (area > 0.0 && failures < 20000) {
+    if (try_insert_on_roller(x0, x1, h0, h1)) {
+      const double d = sim_->bodies().size.back();
+      area -= pi * d * d / 4.0;
+      ++n;
+    } else {
+      ++failures;
     }
   }
-  spec.position = pos;
-  spec.angle = angle;
-  // Move with the drum surface (rigid rotation about the drum axis).
-  const auto& drum = sim_->walls()[1];
-  spec.velocity = cross(drum.omega, pos - drum.centre);
-  spec.omega = drum.omega;
-  spec.tag = 0;
-  // offsets relative to their own centroid; the engine recentres on the mass centre
-  sim_->add_body(spec);
-  ++inserted_;
-  return true;
+  return n;
+}
+
+std::vector<double> NipRun::assembly_x(double max_height) const {
+  std::vector<double> xs;
+  const auto& b = sim_->bodies();
+  for (std::size_t i = 0; i < b.x.size(); ++i) {
+    if (b.x[i] < cfg_.x_min || b.x[i] > cfg_.x_max) continue;
+    if (b.y[i] - roller_surface_y(b.x[i]) < max_height) xs.push_back(b.x[i]);
+  }
+  return xs;
 }
 
 void NipRun::prefill() {
@@ -120,14 +163,12 @@ void NipRun::prefill() {
   const double a50 = pi * cfg_.size.d50 * cfg_.size.d50 / 4.0;
   int failures = 0;
   while (area > 0.5 * a50 && failures < 20000) {
-    const auto before = inserted_;
     if (try_insert(cfg_.x_min, cfg_.x_max)) {
       const double d = sim_->bodies().size.back();
       area -= pi * d * d / 4.0;
     } else {
       ++failures;
     }
-    (void)before;
   }
 }
 

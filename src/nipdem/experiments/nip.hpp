@@ -41,6 +41,12 @@ class NipRun {
   void advance_to(double t_end, const std::function<void()>& on_interval = {});
   // One inflow/outflow pass (also done automatically every interval).
   void exchange();
+  // Fills [x0, x1] between heights h0 and h1 above the roller surface with resting toner at
+  // the given area fraction (the reduction experiment's assembly, §4.6). Returns the count.
+  int fill_on_roller(double x0, double x1, double h0, double h1, double area_fraction);
+  // x of the bodies that belong to the assembly on the roller: centre of mass closer to the
+  // roller than `max_height` [m] (front/back positions, §4.6, §5.1).
+  std::vector<double> assembly_x(double max_height) const;
 
   engine::Simulation& sim() { return *sim_; }
   const engine::Simulation& sim() const { return *sim_; }
@@ -73,6 +79,9 @@ class NipRun {
 
  private:
   bool try_insert(double x_lo, double x_hi);
+  // Insert one particle at random in x [x_lo, x_hi], height [h_lo, h_hi] above the roller.
+  bool try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi);
+  bool place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega);
   void prefill();
 
   NipConfig cfg_;

@@ -1,0 +1,122 @@
+// `nipdem experiment front-position|reduction|vo-level|edge-sharpness` (CLI.md).
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/experiments/ensemble.hpp"
+#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "registry.hpp"
+
+namespace {
+using namespace nipdem::experiments;
+
+struct Common {
+  ExperimentOptions o;
+  std::string out = "";
+  bool json = false, quiet = false;
+};
+
+std::vector<double> parse_list(const std::string& text, const std::string& key) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t pos = 0;
+      v.push_back(std::stod(item, &pos));
+      if (pos != item.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      nipdem::throw_input("experiment", key, "\"" + text + "\"", "expected a comma-separated list of numbers");
+    }
+  }
+  if (v.empty()) nipdem::throw_input("experiment", key, "\"" + text + "\"", "empty list");
+  return v;
+}
+
+void add_common(CLI::App* sub, const std::shared_ptr<Common>& c, const std::string& name) {
+  sub->add_option("--preset", c->o.preset, "black or color")->capture_default_str();
+  sub->add_option("--config", c->o.config, "a config file instead of a preset");
+  sub->add_option("--set", c->o.sets, "override a config key for every run (repeatable)");
+  sub->add_option("--seed", c->o.seed, "base seed (same seed, same result)")->capture_default_str();
+  sub->add_option("--jobs", c->o.jobs, "threads running points/realizations in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  sub->add_flag("--mpi", c->o.mpi, "spread points over MPI ranks (under mpirun); results gathered on rank 0");
+  sub->add_option("--out", c->out, "output folder (default runs/" + name + ")");
+  sub->add_flag("--json", c->json, "print one JSON object on stdout");
+  sub->add_flag("--quiet", c->quiet, "no progress on stderr");
+}
+
+void finish(const std::shared_ptr<Common>& c, const std::string& name, const std::function<nlohmann::json()>& run) {
+  if (c->out.empty()) c->out = "runs/" + name;
+  c->o.out = c->out;
+  c->o.progress = !c->quiet;
+  std::unique_ptr<nipdem::ensemble::MpiSession> mpi;
+  if (c->o.mpi) mpi = std::make_unique<nipdem::ensemble::MpiSession>();
+  const nlohmann::json j = run();
+  if (mpi && mpi->rank() != 0) return;
+  nipdem::io::write_file_atomic(c->o.out / (name + ".json"), j.dump(2));
+  if (c->json) nipdem::cli::print_json(j.dump());
+  else std::fprintf(stderr, "%s: results in %s\n", name.c_str(), c->o.out.c_str());
+  if (j.value("n_failed", 0) > 0) throw std::runtime_error(std::to_string(j["n_failed"].get<int>()) + " point(s) failed; see \"failed\" in " + (c->o.out / (name + ".json")).string());
+}
+
+nipdem::cli::Register reg([](CLI::App& app) {
+  auto* g = nipdem::cli::group(app, "experiment", "Experiments of thesis chapters 4-5 (ensembles on threads or MPI)");
+  {
+    auto c = std::make_shared<Common>();
+    auto gaps = std::make_shared<std::string>("150e-6");
+    auto speeds = std::make_shared<std::string>();
+    auto f = std::make_shared<FrontPositionOptions>();
+    auto* sub = g->add_subcommand("front-position", "Clean-state front position vs gap and sleeve speed (§5.1)");
+    add_common(sub, c, "front-position");
+    sub->add_option("--gap", *gaps, "gaps w_h [m], comma-separated")->capture_default_str();
+    sub->add_option("--sleeve-speed", *speeds, "sleeve surface speeds [m/min], comma-separated (default: the preset's)");
+    sub->add_option("--max-time", f->max_time_s, "give up after this simulated time [s]")->capture_default_str();
+    sub->add_option("--min-time", f->min_time_s, "earliest time a run may be called steady [s]")->capture_default_str();
+    sub->callback([=] {
+      f->gaps_m = parse_list(*gaps, "--gap");
+      if (!speeds->empty()) f->sleeve_speeds_m_per_min = parse_list(*speeds, "--sleeve-speed");
+      finish(c, "front-position", [&] { return front_position(c->o, *f); });
+    });
+  }
+  {
+    auto c = std::make_shared<Common>();
+    auto rs = std::make_shared<std::string>("1");
+    auto r = std::make_shared<ReductionOptions>();
+    auto* sub = g->add_subcommand("reduction", "Reduction experiment: removal by the sleeve vs r = F_coh/F_adh (§4.6)");
+    add_common(sub, c, "reduction");
+    sub->add_option("--r", *rs, "cohesion ratios r, comma-separated")->capture_default_str();
+    sub->add_option("--time", r->time_s, "observation time [s] (thesis: 0.1)")->capture_default_str();
+    sub->add_option("--pile-width", r->pile_width_m, "initial assembly width [m]")->capture_default_str();
+    sub->add_option("--pile-height", r->pile_height_m, "initial assembly height [m]")->capture_default_str();
+    sub->callback([=] {
+      r->cohesion_ratios = parse_list(*rs, "--r");
+      finish(c, "reduction", [&] { return reduction(c->o, *r); });
+    });
+  }
+  {
+    auto c = std::make_shared<Common>();
+    auto v = std::make_shared<VoOptions>();
+    auto* sub = g->add_subcommand("vo-level", "Lowest drum voltage that prints (§5.2), statistics over seeds");
+    add_common(sub, c, "vo-level");
+    sub->add_option("--step", v->step_V, "voltage step [V]")->capture_default_str();
+    sub->add_option("--v0", v->v0_V, "first voltage [V]")->capture_default_str();
+    sub->add_option("--vmax", v->v_max_V, "give up above this voltage [V]")->capture_default_str();
+    sub->add_option("--seeds", v->seeds, "independent realizations")->capture_default_str();
+    sub->add_option("--line-length", v->print.line_length_m, "printed line length on the drum [m]")->capture_default_str();
+    sub->callback([=] { finish(c, "vo-level", [&] { return vo_level(c->o, *v); }); });
+  }
+  {
+    auto c = std::make_shared<Common>();
+    auto e = std::make_shared<EdgeOptions>();
+    auto* sub = g->add_subcommand("edge-sharpness", "Edge widths (10-90 %) of printed lines over realizations (§1.4, §5.3)");
+    add_common(sub, c, "edge-sharpness");
+    sub->add_option("--realizations", e->realizations, "printed lines")->capture_default_str();
+    sub->add_option("--line-length", e->print.line_length_m, "printed line length on the drum [m]")->capture_default_str();
+    sub->add_option("--bootstrap", e->bootstrap, "bootstrap resamples")->capture_default_str();
+    sub->callback([=] { finish(c, "edge-sharpness", [&] { return edge_sharpness(c->o, *e); }); });
+  }
+});
+}  // namespace

@@ -1,0 +1,304 @@
+#include "nipdem/experiments/nip_experiments.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fmt/format.h>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/experiments/analysis.hpp"
+#include "nipdem/experiments/ensemble.hpp"
+#include "nipdem/experiments/nip.hpp"
+#include "nipdem/experiments/presets.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/plot.hpp"
+#include "nipdem/version.hpp"
+
+namespace nipdem::experiments {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::string>& point_sets) {
+  std::vector<std::string> sets = o.sets;
+  sets.insert(sets.end(), point_sets.begin(), point_sets.end());
+  if (!o.config.empty()) return load_nip_config(o.config, sets);
+  return parse_nip_config(preset_text(o.preset), "preset:" + o.preset, sets);
+}
+
+namespace {
+std::string num(double v) { return fmt::format("{:.10g}", v); }
+
+ensemble::Options ens(const ExperimentOptions& o, std::size_t count, const std::string& sub) {
+  ensemble::Options e;
+  e.count = count;
+  e.seed = o.seed;
+  e.jobs = o.jobs;
+  e.mpi = o.mpi;
+  e.resume = o.resume;
+  e.dir = o.out / sub;
+  if (o.progress)
+    e.progress = [sub](std::size_t done, std::size_t total) { std::fprintf(stderr, "%s: %zu/%zu done\n", sub.c_str(), done, total); };
+  return e;
+}
+
+json failures(const ensemble::Summary& s) {
+  json f = json::array();
+  for (const auto& r : s.records) if (!r.ok) f.push_back({{"index", r.index}, {"seed", r.seed}, {"error", r.error}});
+  return f;
+}
+
+json meta(const ExperimentOptions& o) {
+  return {{"git_hash", kGitHash}, {"preset", o.config.empty() ? o.preset : ""}, {"config", o.config}, {"set", o.sets},
+          {"seed", o.seed}, {"jobs", o.jobs}, {"mpi", o.mpi}};
+}
+}  // namespace
+
+// ---------------------------------------------------------------- front position (§5.1)
+json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
+  if (f.gaps_m.empty()) throw_input("experiment front-position", "--gap", "", "need at least one gap");
+  for (double g : f.gaps_m) require_range("experiment front-position", "--gap", g, 20e-6, 5e-3);
+  for (double v : f.sleeve_speeds_m_per_min) require_range("experiment front-position", "--sleeve-speed", v, 0.0, 1000.0);
+  if (!(f.max_time_s >= f.min_time_s)) throw_input("experiment front-position", "max_time_s", num(f.max_time_s), "must be >= min_time_s");
+  std::vector<std::pair<double, double>> points;  // (gap, speed m/s; <0 = preset)
+  const std::vector<double> speeds = f.sleeve_speeds_m_per_min.empty() ? std::vector<double>{-1.0} : f.sleeve_speeds_m_per_min;
+  for (double v : speeds) for (double g : f.gaps_m) points.emplace_back(g, v < 0 ? -1.0 : v / 60.0);
+  // Validate every point's configuration before running anything.
+  auto point_sets = [&](std::size_t i) {
+    std::vector<std::string> s = {"geometry.gap_m=" + num(points[i].first), "output.vtk=false"};
+    if (points[i].second >= 0) s.push_back("geometry.roller_surface_speed_m_per_s=" + num(points[i].second));
+    return s;
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) experiment_config(o, point_sets(i));
+  auto task = [&](std::size_t i, std::uint64_t seed) {
+    auto sets = point_sets(i);
+    sets.push_back("run.seed=" + std::to_string(seed % (1ULL << 62)));
+    NipRun run(experiment_config(o, sets));
+    std::vector<double> t, front, back;
+    analysis::SteadyState st;
+    analysis::ExtentOptions eo{analysis::FrontAt::min_x, 3, 0.0};
+    const double h = 0.5 * run.config().gap;
+    while (run.sim().time() < f.max_time_s) {
+      run.advance_to(run.sim().time() + f.sample_interval_s);
+      const auto xs = run.assembly_x(h);
+      if (xs.size() < 8) continue;  // no assembly (yet)
+      const auto e = analysis::assembly_extent(run.sim().time(), xs, eo);
+      t.push_back(e.t); front.push_back(e.front); back.push_back(e.back);
+      if (run.sim().time() >= f.min_time_s && t.size() >= 40 && t.size() % 10 == 0) {
+        st = analysis::detect_steady_state(t, front);
+        if (st.steady) break;
+      }
+    }
+    if (t.size() >= 40) st = analysis::detect_steady_state(t, front);
+    json series = json::array();
+    for (std::size_t k = 0; k < t.size(); ++k) series.push_back({t[k], front[k], back[k]});
+    return json{{"gap_m", points[i].first}, {"sleeve_speed_m_per_s", run.config().roller_speed},
+                {"front_m", st.value}, {"front_std_m", st.std}, {"front_stderr_m", st.stderr_mean},
+                {"steady", st.steady}, {"not_steady_reason", st.reason}, {"t_onset_s", st.t_onset},
+                {"simulated_s", run.sim().time()}, {"series_t_front_back_m", series}};
+  };
+  const auto sum = ensemble::run(task, ens(o, points.size(), "front_position"));
+  if (!sum.is_root) return {};
+  json rows = json::array();
+  std::string csv = "gap_m,sleeve_speed_m_per_s,front_m,front_std_m,steady\n";
+  std::map<double, io::Series> by_speed;
+  for (const auto& r : sum.records) {
+    if (!r.ok) continue;
+    json row = r.result;
+    csv += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{}\n", row["gap_m"].get<double>(), row["sleeve_speed_m_per_s"].get<double>(),
+                       row["front_m"].get<double>(), row["front_std_m"].get<double>(), row["steady"].get<bool>() ? 1 : 0);
+    const double v = row["sleeve_speed_m_per_s"].get<double>();
+    auto& s = by_speed[v];
+    s.label = fmt::format("v_h = {:.3g} m/min", v * 60);
+    s.markers = true;
+    s.x.push_back(row["gap_m"].get<double>() * 1e6);
+    s.y.push_back(row["front_m"].get<double>() * 1e6);
+    s.y_err.push_back(row["front_std_m"].get<double>() * 1e6);
+    row.erase("series_t_front_back_m");
+    rows.push_back(row);
+  }
+  io::write_file_atomic(o.out / "front_position.csv", csv);
+  io::PlotSpec plot{.title = "Clean-state front position (thesis §5.1)", .x_label = "gap w_h [µm]",
+                    .y_label = "front position x [µm] (magnet edge = 0)"};
+  for (auto& [v, s] : by_speed) plot.series.push_back(s);
+  if (!plot.series.empty() && !plot.series[0].x.empty()) io::write_plot_png(o.out / "front_position.png", plot);
+  return {{"experiment", "front-position"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
+          {"csv", (o.out / "front_position.csv").string()}, {"plot", (o.out / "front_position.png").string()}, {"meta", meta(o)}};
+}
+
+// ---------------------------------------------------------------- reduction (§4.6)
+json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
+  if (r.cohesion_ratios.empty()) throw_input("experiment reduction", "--r", "", "need at least one cohesion ratio");
+  for (double v : r.cohesion_ratios) require_range("experiment reduction", "--r", v, 0.0, 1e6);
+  require_range("experiment reduction", "--time", r.time_s, 1e-6, 10.0);
+  auto point_sets = [&](std::size_t i) {
+    const double w = r.window_half_width_m;
+    return std::vector<std::string>{"adhesion.cohesion_ratio=" + num(r.cohesion_ratios[i]),
+                                    "geometry.gap_m=4e-3",  // no DI-drum: it is far away
+                                    "inflow.layer_thickness_m=0", "inflow.prefill=false", "output.vtk=false",
+                                    "electric.enabled=false",
+                                    "geometry.window_x_min_m=" + num(-w), "geometry.window_x_max_m=" + num(w)};
+  };
+  for (std::size_t i = 0; i < r.cohesion_ratios.size(); ++i) experiment_config(o, point_sets(i));
+  auto task = [&](std::size_t i, std::uint64_t seed) {
+    auto sets = point_sets(i);
+    sets.push_back("run.seed=" + std::to_string(seed % (1ULL << 62)));
+    NipRun run(experiment_config(o, sets));
+    const int n0 = run.fill_on_roller(-0.5 * r.pile_width_m, 0.5 * r.pile_width_m, 0.0, r.pile_height_m, r.pile_area_fraction);
+    std::vector<analysis::Extent> ext;
+    analysis::ExtentOptions eo{analysis::FrontAt::max_x, 3, 0.0};  // front: nearer the supply roller side
+    const double half_dt = 0.5 * run.time_step().dt;  // time lands within dt/2 of a target
+    while (run.sim().time() < r.time_s - half_dt) {
+      run.advance_to(std::min(r.time_s, run.sim().time() + r.sample_interval_s));
+      const auto xs = run.assembly_x(r.pile_height_m * 2.0);
+      if (xs.size() >= 8) ext.push_back(analysis::assembly_extent(run.sim().time(), xs, eo));
+    }
+    json res{{"r", r.cohesion_ratios[i]}, {"initial_particles", n0}, {"removed", run.removed(Exit::returned) + run.removed(Exit::developed)},
+             {"lost", run.removed(Exit::lost)}, {"time_s", run.sim().time()}};
+    if (ext.size() >= 3) {
+      const auto rs = analysis::reduction_speed(ext);
+      res["reduction_speed_m_per_s"] = rs.speed;
+      res["reduction_speed_stderr_m_per_s"] = rs.speed_stderr;
+    }
+    json series = json::array();
+    for (const auto& e : ext) series.push_back({e.t, e.front, e.back, e.size, e.n});
+    res["series_t_front_back_size_n"] = series;
+    return res;
+  };
+  const auto sum = ensemble::run(task, ens(o, r.cohesion_ratios.size(), "reduction"));
+  if (!sum.is_root) return {};
+  json rows = json::array();
+  std::string csv = "r,removed,time_s,removed_per_100ms,reduction_speed_m_per_s,reduction_speed_stderr_m_per_s\n";
+  io::Series s{.label = "removed in the observation time", .markers = true};
+  for (const auto& rec : sum.records) {
+    if (!rec.ok) continue;
+    json row = rec.result;
+    const double T = row["time_s"].get<double>();
+    row["removed_per_100ms"] = row["removed"].get<double>() * 0.1 / T;
+    csv += fmt::format("{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g}\n", row["r"].get<double>(), row["removed"].get<long>(), T,
+                       row["removed_per_100ms"].get<double>(), row.value("reduction_speed_m_per_s", NAN),
+                       row.value("reduction_speed_stderr_m_per_s", NAN));
+    s.x.push_back(row["r"].get<double>());
+    s.y.push_back(std::max(row["removed"].get<double>(), 0.5));
+    // time series of each r as its own CSV
+    std::string ts = "time_s,front_m,back_m,size_m,particles\n";
+    for (auto& e : row["series_t_front_back_size_n"]) ts += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{}\n", e[0].get<double>(), e[1].get<double>(), e[2].get<double>(), e[3].get<double>(), e[4].get<long>());
+    io::write_file_atomic(o.out / fmt::format("reduction_r{:g}.csv", row["r"].get<double>()), ts);
+    row.erase("series_t_front_back_size_n");
+    rows.push_back(row);
+  }
+  io::write_file_atomic(o.out / "reduction.csv", csv);
+  if (!s.x.empty()) {
+    io::PlotSpec p{.title = "Reduction experiment (thesis §4.6, fig. 4.25 analogue)", .x_label = "r = F_coh / F_adh",
+                   .y_label = "particles removed", .log_x = s.x.size() > 1 && s.x.front() > 0, .log_y = true};
+    p.series.push_back(s);
+    io::write_plot_png(o.out / "reduction.png", p);
+  }
+  return {{"experiment", "reduction"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
+          {"table_4_3_reduction_speed_m_per_s", {{"black", 7.6e-4}, {"color", 2.5e-4}}},
+          {"csv", (o.out / "reduction.csv").string()}, {"meta", meta(o)}};
+}
+
+// ---------------------------------------------------------------- printing (§5.2, §5.3)
+namespace {
+struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; };
+
+PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double voltage, std::uint64_t seed) {
+  std::vector<std::string> sets = {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=" + num(voltage),
+                                   "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
+                                   "output.vtk=false", "run.seed=" + std::to_string(seed % (1ULL << 62))};
+  NipConfig cfg = experiment_config(o, sets);
+  // run until the end of the line has passed the window's downstream edge
+  const double v = std::fabs(cfg.drum_speed);
+  const double t_end = (p.line_start_m + p.line_length_m + (cfg.nip_x - cfg.x_min)) / v + p.extra_time_s;
+  NipRun run(cfg);
+  run.advance_to(t_end);
+  return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), run.sim().time()};
+}
+}  // namespace
+
+json vo_level(const ExperimentOptions& o, const VoOptions& v) {
+  require_range("experiment vo-level", "--step", v.step_V, 1e-3, 100.0);
+  if (v.seeds < 1) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "need >= 1");
+  experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=0", "print.length_m=1e-4"});
+  auto task = [&](std::size_t, std::uint64_t seed) {
+    const auto res = analysis::find_vo_level([&](double V) { return print_line(o, v.print, V, seed).printed; },
+                                             {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V});
+    json trace = json::array();
+    for (auto& [V, n] : res.trace) trace.push_back({V, n});
+    return json{{"found", res.found}, {"vo_V", res.vo_V}, {"trace_V_printed", trace}};
+  };
+  const auto sum = ensemble::run(task, ens(o, static_cast<std::size_t>(v.seeds), "vo_level"));
+  if (!sum.is_root) return {};
+  std::vector<double> vo;
+  json per = json::array();
+  for (const auto& r : sum.records) {
+    if (!r.ok) continue;
+    per.push_back(r.result);
+    if (r.result["found"].get<bool>()) vo.push_back(r.result["vo_V"].get<double>());
+  }
+  double mean = 0, sd = 0;
+  for (double x : vo) mean += x;
+  if (!vo.empty()) mean /= vo.size();
+  for (double x : vo) sd += (x - mean) * (x - mean);
+  if (vo.size() > 1) sd = std::sqrt(sd / (vo.size() - 1));
+  return {{"experiment", "vo-level"}, {"vo_mean_V", vo.empty() ? json(nullptr) : json(mean)}, {"vo_std_V", sd},
+          {"seeds_found", vo.size()}, {"seeds_total", v.seeds}, {"per_seed", per}, {"failed", failures(sum)},
+          {"n_failed", sum.n_failed}, {"meta", meta(o)}};
+}
+
+json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
+  if (e.realizations < 2) throw_input("experiment edge-sharpness", "--realizations", std::to_string(e.realizations), "need >= 2");
+  const NipConfig base = experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=40",
+                                                "print.start_m=" + num(e.print.line_start_m), "print.length_m=" + num(e.print.line_length_m)});
+  const double volts = base.electric.pattern.segments().empty() ? 40.0 : base.electric.pattern.segments()[0].voltage_V;
+  auto task = [&](std::size_t, std::uint64_t seed) {
+    const auto pr = print_line(o, e.print, volts, seed);
+    json bins = json::array();
+    for (const auto& b : pr.coverage) bins.push_back({b.s0, b.covered ? 1 : 0});
+    return json{{"printed", pr.printed}, {"bins_s_covered", bins}};
+  };
+  const auto sum = ensemble::run(task, ens(o, static_cast<std::size_t>(e.realizations), "edge_sharpness"));
+  if (!sum.is_root) return {};
+  // Common grid over all realizations: bin width d50/4 from the line start - 200 um to end + 200 um.
+  const double bin = 0.25 * base.size.d50;
+  const double lo = e.print.line_start_m - 200e-6, hi = e.print.line_start_m + e.print.line_length_m + 200e-6;
+  const int n = static_cast<int>(std::lround((hi - lo) / bin));
+  std::vector<double> x(n);
+  for (int k = 0; k < n; ++k) x[k] = lo + (k + 0.5) * bin;
+  std::vector<std::vector<double>> curves;
+  long printed_total = 0;
+  for (const auto& r : sum.records) {
+    if (!r.ok) continue;
+    std::vector<double> c(n, 0.0);
+    for (auto& b : r.result["bins_s_covered"]) {
+      const int k = static_cast<int>(std::floor((b[0].get<double>() + 0.5 * bin - lo) / bin));
+      if (k >= 0 && k < n && b[1].get<int>()) c[k] = 1.0;
+    }
+    printed_total += r.result["printed"].get<long>();
+    curves.push_back(c);
+  }
+  json out = {{"experiment", "edge-sharpness"}, {"realizations", curves.size()}, {"printed_particles", printed_total},
+              {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"meta", meta(o)}};
+  const auto avg = curves.empty() ? std::vector<double>(n, 0.0) : analysis::average_curve(curves);
+  double peak = 0;
+  for (double c : avg) peak = std::max(peak, c);
+  if (peak <= 0.0) {
+    out["error"] = "nothing was printed in any realization: no edge to fit (see docs/results)";
+    out["edge_front_m"] = nullptr;
+    out["edge_back_m"] = nullptr;
+    return out;
+  }
+  analysis::SigmoidOptions so;
+  so.binomial_realizations = static_cast<int>(curves.size());
+  // The drum carries the line towards -x; its front (printed first) is at low s.
+  const auto boot = analysis::bootstrap_line_edges(x, curves, e.bootstrap, o.seed, 0.95, so, analysis::FrontSide::low_x);
+  const auto fit = analysis::fit_line_edges(x, avg, so, analysis::FrontSide::low_x);
+  json js = analysis::edge_sharpness_json(boot, curves.size());
+  for (auto& [k, v] : js.items()) out[k] = v;
+  analysis::write_coverage_csv(o.out / "coverage_average.csv", x, avg, fit);
+  io::write_plot_png(o.out / "coverage_average.png", analysis::coverage_plot(x, avg, fit, "Average coverage of printed lines (fig. 1.8 analogue)"));
+  out["coverage_file"] = (o.out / "coverage_average.csv").string();
+  return out;
+}
+
+}  // namespace nipdem::experiments

@@ -1,0 +1,76 @@
+// The experiments of thesis chapters 4 and 5 run on the nip model, each as an ensemble of
+// independent sweep points / realizations (threads or MPI, resumable; experiments/ensemble):
+//  - front position of the clean-state assembly vs gap and sleeve speed (§5.1),
+//  - the reduction experiment: no drum, the sleeve strips an assembly resting on the magnet
+//    (§4.6, fig. 4.25, Table 4.3),
+//  - the Vo-level: the lowest drum voltage that prints (§5.2),
+//  - edge sharpness from many printed lines (§1.4, §5.3).
+// Each returns one JSON object (CLI.md keys) and writes CSV data and PNG plots to `out`.
+#pragma once
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/experiments/nip_config.hpp"
+
+namespace nipdem::experiments {
+
+struct ExperimentOptions {
+  std::string preset = "black";       // base configuration (unless config is given)
+  std::string config;                 // a config file instead of a preset
+  std::vector<std::string> sets;      // KEY=VALUE overrides applied to every point
+  std::uint64_t seed = 1;
+  int jobs = 1;
+  bool mpi = false;
+  bool resume = true;
+  std::filesystem::path out = "runs/experiment";
+  bool progress = true;
+};
+
+struct FrontPositionOptions {
+  std::vector<double> gaps_m = {150e-6};
+  std::vector<double> sleeve_speeds_m_per_min;  // empty: the preset's
+  double sample_interval_s = 2e-5;
+  double min_time_s = 1e-3;            // never call a run steady before this
+  double max_time_s = 5e-3;            // give up (reported as not steady)
+};
+nlohmann::json front_position(const ExperimentOptions& o, const FrontPositionOptions& f);
+
+struct ReductionOptions {
+  std::vector<double> cohesion_ratios = {1.0};
+  double time_s = 0.1;                 // observation time (thesis: 100 ms)
+  double sample_interval_s = 1e-4;
+  double pile_width_m = 400e-6;        // assembly initially resting on the knife
+  double pile_height_m = 120e-6;
+  double pile_area_fraction = 0.6;
+  double window_half_width_m = 600e-6;
+};
+nlohmann::json reduction(const ExperimentOptions& o, const ReductionOptions& r);
+
+struct PrintOptions {
+  double line_length_m = 0.2e-3;       // printed line on the drum (track on while it passes)
+  double line_start_m = 0.0;
+  double extra_time_s = 0.0;           // beyond the time the line needs to leave the window
+};
+struct VoOptions {
+  double v0_V = 0.0, step_V = 0.5, v_max_V = 60.0;
+  int seeds = 3;
+  PrintOptions print;
+};
+nlohmann::json vo_level(const ExperimentOptions& o, const VoOptions& v);
+
+struct EdgeOptions {
+  int realizations = 50;
+  PrintOptions print;
+  int bootstrap = 400;
+};
+nlohmann::json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e);
+
+// Base configuration of an experiment point: preset or file, then the user's --set, then
+// the point's own overrides.
+NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::string>& point_sets);
+
+}  // namespace nipdem::experiments

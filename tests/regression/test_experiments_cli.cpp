@@ -1,0 +1,66 @@
+// Experiment commands: bad sweep specifications exit 2 with clear messages; a tiny
+// reduction run produces the documented JSON keys and files (its analysis code is tested on
+// known input in tests/unit/test_analysis_*.cpp).
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/io/atomic_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+struct Res { int status; std::string out, err; };
+Res cli(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / ("nipdem_exp_err_" + std::to_string(::getpid()));
+  FILE* p = popen((std::string(NIPDEM_CLI_PATH) + " " + args + " 2>" + err.string()).c_str(), "r");
+  Res r{};
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  r.err = nipdem::io::read_file(err);
+  fs::remove(err);
+  return r;
+}
+}  // namespace
+
+TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_bad_" + std::to_string(::getpid()));
+  struct C { std::string args, needle; };
+  for (const C& c : {C{"experiment reduction --r 1,abc", "--r"}, C{"experiment front-position --gap -1e-6", "--gap"},
+                     C{"experiment front-position --gap 150e-6 --sleeve-speed x", "--sleeve-speed"},
+                     C{"experiment reduction --preset purple", "unknown preset"},
+                     C{"experiment edge-sharpness --realizations 1", "--realizations"},
+                     C{"experiment front-position --set geometry.gap_mm=1", "geometry.gap_mm"}}) {
+    SCOPED_TRACE(c.args);
+    const auto r = cli(c.args + " --out " + d.string() + " --quiet");
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(c.needle), std::string::npos) << r.err;
+  }
+  fs::remove_all(d);
+}
+
+TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_red_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const auto r = cli("experiment reduction --r 1 --time 2e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 1u);
+  const auto& p = j["points"][0];
+  EXPECT_GT(p["initial_particles"].get<int>(), 10);
+  EXPECT_GE(p["removed"].get<int>(), 0);
+  EXPECT_EQ(p["lost"].get<int>(), 0);
+  EXPECT_TRUE(fs::exists(d / "reduction.csv"));
+  EXPECT_TRUE(fs::exists(d / "reduction.json"));
+  // resumable: a rerun loads the finished point instead of recomputing it
+  const auto again = cli("experiment reduction --r 1 --time 2e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(again.out)["points"], j["points"]);
+  fs::remove_all(d);
+}
