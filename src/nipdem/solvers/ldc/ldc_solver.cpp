@@ -76,7 +76,10 @@ void LdcSolver::Impl::setup_geometry() {
       for (int i = i0; i <= i1; ++i)
         if (norm(grid.node(i, j) - discs[k].center_m) <= discs[k].radius_m * (1 + 1e-12)) {
           const int n = grid.index(i, j);
-          if (!grid.box_dirichlet(n)) { cond_mask[n] = 1; cond_disc[n] = k; }
+          if (!grid.box_dirichlet(n)) {
+            cond_mask[n] = p.dirichlet_conductor_nodes ? 1 : 0;
+            cond_disc[n] = k;
+          }
         }
   }
   if (coarse.set_extra_dirichlet(cond_mask)) ++stats.coarse_factorisations;
@@ -127,7 +130,7 @@ void LdcSolver::Impl::setup_geometry() {
       for (int m = 0; m < int(mem.size()); ++m) {
         const Disc& d = discs[mem[m]];
         const double r2 = gr.def.r2[m];
-        gr.samples[m] = AnnulusSolution::samples_for(r2, hmin);
+        gr.samples[m] = AnnulusSolution::samples_for(r2, hmin / p.gamma_points_per_cell);
         for (int j = 0; j < gr.samples[m]; ++j)
           gamma_pts.push_back(AnnulusSolution::sample_point(d.center_m, r2, j, gr.samples[m]));
         int i0, i1, j0, j1;
@@ -236,7 +239,7 @@ void LdcSolver::Impl::run() {
 
   for (int it = 1; it <= p.max_iterations; ++it) {
     for (int n = 0; n < grid.size(); ++n)
-      if (cond_disc[n] >= 0) u[n] = g[cond_disc[n]];
+      if (cond_mask[n]) u[n] = g[cond_disc[n]];
     coarse.solve(source, u);
     double delta = 0.0;
     for (std::size_t s = 0; s < gamma_pts.size(); ++s) {
@@ -252,13 +255,10 @@ void LdcSolver::Impl::run() {
     double kappa = 0.0;
     for (const Group& gr : groups)
       for (int n : gr.owned) {
-        if (coarse.is_dirichlet(n)) continue;
-        w[n] = local_value(gr, n);
-        kappa = std::max(kappa, std::abs(w[n] - u[n]));
+        if (grid.box_dirichlet(n)) continue;
+        w[n] = cond_disc[n] >= 0 ? g_new[cond_disc[n]] : local_value(gr, n);
+        if (!coarse.is_dirichlet(n)) kappa = std::max(kappa, std::abs(w[n] - u[n]));
       }
-    for (const Group& gr : groups)
-      for (int n : gr.owned)
-        if (cond_disc[n] >= 0) w[n] = g_new[cond_disc[n]];
     for (const Group& gr : groups)
       for (int n : gr.defect) source[n] = grid.laplacian(w, n % nx, n / nx);
     stats.kappa.push_back(kappa);

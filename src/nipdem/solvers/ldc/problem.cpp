@@ -36,6 +36,7 @@ void validate(const Params& p) {
   require_positive(where, "permittivity_F_per_m", p.permittivity_F_per_m);
   require_range(where, "local_radius_factor", p.local_radius_factor, 1.2, inf);
   require_range(where, "local_min_cells", p.local_min_cells, 1.0, inf);
+  require_range(where, "gamma_points_per_cell", p.gamma_points_per_cell, 0.25, 64.0);
   require_range(where, "fd_refinement", p.fd_refinement, 1, 64);
   require_range(where, "fd_min_points_per_radius", p.fd_min_points_per_radius, 1.0, 64.0);
   require_range(where, "safety_m", p.safety_m, 0.0, inf);

@@ -48,6 +48,8 @@ struct Params {
   // Local domain radius R2 = max(local_radius_factor * R1, R1 + local_min_cells * H).
   double local_radius_factor = 3.0;
   double local_min_cells = 2.0;
+  // Samples 2N+1 of u on each circle Γ (eqs. 3.4.4-3.4.5): about this many per coarse cell length.
+  double gamma_points_per_cell = 1.0;
   // Fine grid of finite-difference local problems: h = H / fd_refinement, raised automatically so
   // that every disc radius spans at least fd_min_points_per_radius fine cells.
   int fd_refinement = 4;
@@ -61,6 +63,13 @@ struct Params {
   int schwarz_max_iterations = 500;
   double schwarz_tolerance = 1e-12;  // relative to the potential scale
   double initial_potential_V = 0.0;   // u_guess of eq. 3.2.2 for a cold start
+  // true: coarse nodes inside a disc are Dirichlet nodes u = g (eq. 3.2.2, as in the thesis);
+  // the coarse problem then learns the charge only through g, and the iteration converges with
+  // the factor log(R3/R2)/log(R3/R1) of §3.7, slow when the box is large (R3 >> R2).
+  // false: they are ordinary coarse unknowns carrying the defect of the local solution (= g
+  // inside the disc), so the defect holds the whole charge from the first correction and the
+  // monopole error disappears in one step; the coarse matrix never changes (docs/ldc.md).
+  bool dirichlet_conductor_nodes = false;
   // Force the finite-difference local solution for every disc (testing); default: automatic.
   bool force_finite_difference = false;
 
