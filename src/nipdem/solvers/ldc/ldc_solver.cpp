@@ -94,7 +94,12 @@ void LdcSolver::Impl::setup_geometry() {
   const double hmin = std::min(grid.hx(), grid.hy());
   const double eps_depth = 1e-9 * hmin;
   std::vector<double> depth(grid.size(), -1.0);
+  // Annuli claim their coarse nodes first; a finite-difference rectangle that overlaps an annulus
+  // keeps only the rest (both local solutions are valid there, but each node needs one owner
+  // whose local domain contains its whole stencil for the defect).
+  for (int pass = 0; pass < 2; ++pass)
   for (int gi = 0; gi < int(defs.size()); ++gi) {
+    if ((defs[gi].method == LocalMethod::finite_difference) != (pass == 1)) continue;
     Group& gr = groups[gi];
     gr.def = defs[gi];
     const auto& mem = gr.def.members;

@@ -10,6 +10,7 @@ namespace nipdem::ldc {
 
 namespace {
 constexpr int kMaxGapRefinement = 32;
+constexpr double kMaxFineNodes = 4e5;
 
 struct UnionFind {
   std::vector<int> parent;
@@ -48,16 +49,28 @@ std::vector<LocalGroup> build_local_groups(const CoarseGrid& grid, std::span<con
   std::vector<char> need_fd(n, 0);
   for (int k = 0; k < n; ++k) {
     r2[k] = local_radius(p, discs[k]);
+    // Shrink the annulus so that it contains no other disc (condition 3.9.16 for Schwarz),
+    // keeping 20 % of the gap free.
+    for (int j = 0; j < n; ++j) {
+      if (j == k) continue;
+      const double d = norm(discs[k].center_m - discs[j].center_m);
+      const double gap = d - discs[k].radius_m - discs[j].radius_m;
+      r2[k] = std::min(r2[k], d - discs[j].radius_m - 0.2 * gap);
+    }
     // An annulus thinner than one coarse cell has no coarse node for the defect.
     if (p.force_finite_difference || r2[k] < discs[k].radius_m + h) need_fd[k] = 1;
   }
-  UnionFind uf(n);
-  for (int k = 0; k < n; ++k)
-    for (int j = k + 1; j < n; ++j)
-      if (norm(discs[k].center_m - discs[j].center_m) < r2[k] + r2[j]) uf.unite(k, j);
 
   std::vector<LocalGroup> groups;
+  std::vector<std::pair<int, int>> joined;  // discs forced into one group by rectangle contact
   for (;;) {
+    // Analytic/Schwarz discs group with analytic/Schwarz discs whose annulus overlaps theirs;
+    // finite-difference discs with finite-difference discs (rectangle merging below).
+    UnionFind uf(n);
+    for (int k = 0; k < n; ++k)
+      for (int j = k + 1; j < n; ++j)
+        if (need_fd[k] == need_fd[j] && norm(discs[k].center_m - discs[j].center_m) < r2[k] + r2[j]) uf.unite(k, j);
+    for (auto [a, b] : joined) uf.unite(a, b);
     groups.clear();
     std::vector<int> group_of_root(n, -1);
     for (int k = 0; k < n; ++k) {
@@ -106,18 +119,33 @@ std::vector<LocalGroup> build_local_groups(const CoarseGrid& grid, std::span<con
       // Resolve the gap with ~3 fine cells so the flux condition keeps its offset (local_fd.hpp);
       // capped, beyond the cap the flux circle moves towards the disc surface.
       m = std::max(m, std::min(kMaxGapRefinement, int(std::ceil(3.0 * hmax / gap))));
+      // Keep the local LU affordable: at most kMaxFineNodes fine nodes (but never coarser than
+      // fd_refinement).
+      const double cells = double(g.i1 - g.i0) * double(g.j1 - g.j0);
+      while (m > p.fd_refinement && cells * m * m > kMaxFineNodes) --m;
       g.refinement = m;
     }
-    // A finite-difference rectangle absorbs every other local domain it touches.
+    // A finite-difference rectangle must not cut or contain a disc
+    // that is not one of its conductors, nor overlap another rectangle: such discs join it.
+    // Overlap with another group's annulus is harmless (both local solutions are valid in the
+    // charge-free overlap, and neither domain contains a foreign disc).
     bool merged = false;
     for (const LocalGroup& g : groups) {
       if (g.method != LocalMethod::finite_difference) continue;
       const Vec2 lo = grid.node(g.i0, g.j0), hi = grid.node(g.i1, g.j1);
-      for (int k = 0; k < n; ++k) {
-        if (uf.find(k) == uf.find(g.members[0])) continue;
-        if (rect_distance(lo, hi, discs[k].center_m) < r2[k] + 1e-12) {
-          uf.unite(g.members[0], k);
-          need_fd[k] = 1;
+      for (const LocalGroup& o : groups) {
+        if (&o == &g) continue;
+        bool touch = false;
+        if (o.method == LocalMethod::finite_difference) {
+          touch = o.i0 < g.i1 && g.i0 < o.i1 && o.j0 < g.j1 && g.j0 < o.j1;
+        } else {
+          for (int k : o.members) touch = touch || rect_distance(lo, hi, discs[k].center_m) < discs[k].radius_m;
+        }
+        if (touch) {
+          for (int k : o.members) {
+            need_fd[k] = 1;
+          }
+          joined.emplace_back(g.members[0], o.members[0]);
           merged = true;
         }
       }

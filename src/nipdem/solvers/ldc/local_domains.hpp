@@ -4,7 +4,7 @@
 //   * finite_difference — otherwise (a local domain overlaps another disc, or the annulus would
 //     not fit in the box): one fine-grid rectangle for the whole cluster (§3.10).
 // Groups are connected components of "local domains overlap"; a finite-difference rectangle that
-// covers another group's domain absorbs it.
+// reaches another disc absorbs that disc's group.
 #pragma once
 #include <span>
 #include <vector>
