@@ -12,7 +12,8 @@ namespace nipdem::ldc {
 
 struct FdLocalProblem::Impl {
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
-  Eigen::VectorXd rhs, x;
+  Eigen::SparseMatrix<double> a;
+  Eigen::VectorXd rhs, x, r;
   int free_count = 0;
 };
 
@@ -159,6 +160,7 @@ FdLocalProblem::FdLocalProblem(Vec2 lo, double hx, double hy, int cells_x, int c
   a.setFromTriplets(trip.begin(), trip.end());
   impl_->lu.analyzePattern(a);
   impl_->lu.factorize(a);
+  impl_->a = std::move(a);
   if (impl_->lu.info() != Eigen::Success)
     throw std::runtime_error("ldc: finite-difference local matrix is singular (conductor without free neighbours?)");
   impl_->rhs.resize(nf + ng);
@@ -178,6 +180,12 @@ void FdLocalProblem::solve(const std::function<double(Vec2)>& boundary) {
   for (int k = 0; k < ng; ++k) rhs[nf + k] = cond_[k].charge / eps_;
   for (const Coupling& c : couplings_) rhs[c.row] -= c.coef * u_[c.node];
   impl_->x = impl_->lu.solve(rhs);
+  // Short arms next to a circle make the matrix badly scaled; two steps of iterative refinement
+  // bring the solution back to round-off (without them the LDC iteration stalls at ~1e-4).
+  for (int it = 0; it < 2; ++it) {
+    impl_->r = rhs - impl_->a * impl_->x;
+    impl_->x += impl_->lu.solve(impl_->r);
+  }
   for (int k = 0; k < ng; ++k) g_[k] = impl_->x[nf + k];
   for (int n = 0; n < nx_ * ny_; ++n) {
     if (kind_[n] == -1) u_[n] = impl_->x[unknown_[n]];
