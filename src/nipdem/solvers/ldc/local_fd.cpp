@@ -4,6 +4,7 @@
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "nipdem/core/constants.hpp"
@@ -180,10 +181,15 @@ void FdLocalProblem::solve(const std::function<double(Vec2)>& boundary) {
   for (int k = 0; k < ng; ++k) rhs[nf + k] = cond_[k].charge / eps_;
   for (const Coupling& c : couplings_) rhs[c.row] -= c.coef * u_[c.node];
   impl_->x = impl_->lu.solve(rhs);
-  // Short arms next to a circle make the matrix badly scaled; two steps of iterative refinement
+  // Short arms next to a circle make the matrix badly scaled; iterative refinement steps
   // bring the solution back to round-off (without them the LDC iteration stalls at ~1e-4).
-  for (int it = 0; it < 2; ++it) {
+  // Refine while the residual keeps halving (at most 6 steps).
+  double last = std::numeric_limits<double>::infinity();
+  for (int it = 0; it < 6; ++it) {
     impl_->r = rhs - impl_->a * impl_->x;
+    const double res = impl_->r.lpNorm<Eigen::Infinity>();
+    if (!(res < 0.5 * last)) break;  // no further progress
+    last = res;
     impl_->x += impl_->lu.solve(impl_->r);
   }
   for (int k = 0; k < ng; ++k) g_[k] = impl_->x[nf + k];
