@@ -255,7 +255,7 @@ TEST(LdcSolver, NewtonThirdLawForTwoDiscs) {
   // box (L = 20 x separation). The forces they exert on each other are equal and opposite for
   // the exact solution; the box adds image forces of relative size ~ (d/L)² ~ 3e-3, and the
   // discrete local solutions (each disc's force comes from its own local solution) differ by
-  // O(H²): measured |F1 + F2|/|F1| = 2.3e-2 at H = R (Schwarz), 1.8e-3 at H = R/2.
+  // O(H²): measured |F1 + F2|/|F1| = 1.7e-2 at H = R (Schwarz), 5.4e-3 at H = R/2.
   // Tolerance at H = R/2: 1 %.
   const double L = 2e-3, R = 2e-5, d = 1e-4;
   Params p = grounded_box(L, 200);
