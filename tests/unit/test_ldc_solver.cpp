@@ -255,18 +255,21 @@ TEST(LdcSolver, NewtonThirdLawForTwoDiscs) {
   // box (L = 20 x separation). The forces they exert on each other are equal and opposite for
   // the exact solution; the box adds image forces of relative size ~ (d/L)² ~ 3e-3, and the
   // discrete local solutions (each disc's force comes from its own local solution) differ by
-  // O(H²): measured |F1 + F2|/|F1| = 1.7e-2 at H = R (Schwarz), 5.4e-3 at H = R/2.
-  // Tolerance at H = R/2: 1 %.
+  // O(H²): measured |F1 + F2|/|F1| = 1.7e-2 at H = R (Schwarz), 5.4e-3 at H = R/2 (Schwarz) and
+  // 2.7e-3 at H = R/2 with separate annuli. Tolerance at H = R/2: 1 %. Both local methods.
   const double L = 2e-3, R = 2e-5, d = 1e-4;
-  Params p = grounded_box(L, 200);
-  p.tolerance = 1e-10;
-  LdcSolver s(p);
-  const Disc discs[2] = {{{L / 2 - d / 2, L / 2}, R, 1e-10}, {{L / 2 + d / 2, L / 2}, R, -3e-10}};
-  s.solve(discs);
-  EXPECT_EQ(s.method(0), LocalMethod::schwarz);
-  const Vec2 f1 = s.force(0), f2 = s.force(1);
-  EXPECT_GT(f1.x, 0.0);  // opposite charges attract
-  EXPECT_LT(norm(f1 + f2), 0.01 * norm(f1));
+  for (const bool separate : {false, true}) {
+    Params p = grounded_box(L, 200);
+    p.tolerance = 1e-10;
+    p.prefer_separate_annuli = separate;
+    LdcSolver s(p);
+    const Disc discs[2] = {{{L / 2 - d / 2, L / 2}, R, 1e-10}, {{L / 2 + d / 2, L / 2}, R, -3e-10}};
+    s.solve(discs);
+    EXPECT_EQ(s.method(0), separate ? LocalMethod::analytic : LocalMethod::schwarz);
+    const Vec2 f1 = s.force(0), f2 = s.force(1);
+    EXPECT_GT(f1.x, 0.0);  // opposite charges attract
+    EXPECT_LT(norm(f1 + f2), 0.01 * norm(f1)) << "separate annuli: " << separate;
+  }
 }
 
 TEST(LdcSolver, WarmStartNeedsFewerIterations) {
@@ -289,7 +292,8 @@ TEST(LdcSolver, WarmStartNeedsFewerIterations) {
 }
 
 TEST(LdcSolver, ChoosesLocalMethodByConfiguration) {
-  // Local radius R2 = 3R. Far apart: analytic. Annuli overlap but Γ stays outside the other
+  // Local radius R2 = 3R (prefer_separate_annuli off, so that annuli keep that size). Far apart:
+  // analytic. Annuli overlap but Γ stays outside the other
   // disc (distance > R2 + R): Schwarz. Closer: finite differences. The three methods solve the
   // same problem, so the potentials of the Schwarz configuration computed with the
   // finite-difference local solution must agree: tolerance 1 % (the FD local solution is first
@@ -297,6 +301,7 @@ TEST(LdcSolver, ChoosesLocalMethodByConfiguration) {
   const double R = 2e-5;
   Params p = grounded_box(1e-3, 50);
   p.tolerance = 1e-10;
+  p.prefer_separate_annuli = false;
   LdcSolver s(p);
   const Vec2 c{5e-4, 5e-4};
   Disc far[2] = {{c, R, 1e-10}, {c + Vec2{2e-4, 0}, R, 1e-10}};

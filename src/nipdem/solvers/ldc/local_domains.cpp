@@ -56,6 +56,9 @@ std::vector<LocalGroup> build_local_groups(const CoarseGrid& grid, std::span<con
       const double d = norm(discs[k].center_m - discs[j].center_m);
       const double gap = d - discs[k].radius_m - discs[j].radius_m;
       r2[k] = std::min(r2[k], d - discs[j].radius_m - 0.2 * gap);
+      // Prefer separate annuli (analytic) over Schwarz where both keep at least
+      // R + 1.5 H: large overlapping clusters make the Schwarz sweeps slow.
+      if (p.prefer_separate_annuli && 0.5 * d >= discs[k].radius_m + 1.5 * h) r2[k] = std::min(r2[k], 0.5 * d);
     }
     // An annulus thinner than one coarse cell has no coarse node for the defect.
     if (p.force_finite_difference || r2[k] < discs[k].radius_m + h) need_fd[k] = 1;

@@ -48,6 +48,9 @@ struct Params {
   // Local domain radius R2 = max(local_radius_factor * R1, R1 + local_min_cells * H).
   double local_radius_factor = 3.0;
   double local_min_cells = 2.0;
+  // Shrink annuli to d/2 between neighbours when that keeps R2 >= R1 + local_min_cells * H, so
+  // that overlapping (Schwarz) groups only form where annuli would otherwise be too thin.
+  bool prefer_separate_annuli = true;
   // Samples 2N+1 of u on each circle Γ (eqs. 3.4.4-3.4.5): about this many per coarse cell length.
   double gamma_points_per_cell = 1.0;
   // Fine grid of finite-difference local problems: h = H / fd_refinement, raised automatically so
