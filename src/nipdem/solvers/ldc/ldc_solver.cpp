@@ -34,6 +34,7 @@ struct LdcSolver::Impl {
   std::vector<double> u, w, source, g, g_new;
   std::vector<std::uint8_t> cond_mask;
   std::vector<int> cond_disc, owner;
+  std::vector<double> depth;  // distance of an owned coarse node to its Γ
   std::vector<Vec2> gamma_pts;
   std::vector<double> gamma_prev, gamma_cur;
   std::vector<Vec2> forces;
@@ -50,26 +51,31 @@ struct LdcSolver::Impl {
     owner.assign(n, -1);
   }
 
+  void node_range(Vec2 c, double r, int& i0, int& i1, int& j0, int& j1) const;
+  void mark_conductor_nodes();
+  void setup_annulus_group(int gi);
+  void setup_fd_group(int gi);
+  void select_defect_nodes();
   void setup_geometry();
   void local_solve();
   double local_value(const Group& gr, int n) const;
   void run();
 };
 
-void LdcSolver::Impl::setup_geometry() {
-  const int nd = int(discs.size());
-  const int nx = grid.nx(), ny = grid.ny();
-  // Coarse nodes inside a disc (closed, as in eq. 3.8.4) are Dirichlet nodes with value g_k.
+void LdcSolver::Impl::node_range(Vec2 c, double r, int& i0, int& i1, int& j0, int& j1) const {
+  const Vec2 o = grid.lower();
+  i0 = std::max(0, int(std::floor((c.x - r - o.x) / grid.hx())));
+  i1 = std::min(grid.nx() - 1, int(std::ceil((c.x + r - o.x) / grid.hx())));
+  j0 = std::max(0, int(std::floor((c.y - r - o.y) / grid.hy())));
+  j1 = std::min(grid.ny() - 1, int(std::ceil((c.y + r - o.y) / grid.hy())));
+}
+
+// Coarse nodes inside a disc (closed, as in eq. 3.8.4): Dirichlet nodes u = g_k in the thesis
+// formulation, otherwise free nodes whose local value is g_k.
+void LdcSolver::Impl::mark_conductor_nodes() {
   std::fill(cond_mask.begin(), cond_mask.end(), 0);
   std::fill(cond_disc.begin(), cond_disc.end(), -1);
-  auto node_range = [&](Vec2 c, double r, int& i0, int& i1, int& j0, int& j1) {
-    const Vec2 o = grid.lower();
-    i0 = std::max(0, int(std::floor((c.x - r - o.x) / grid.hx())));
-    i1 = std::min(nx - 1, int(std::ceil((c.x + r - o.x) / grid.hx())));
-    j0 = std::max(0, int(std::floor((c.y - r - o.y) / grid.hy())));
-    j1 = std::min(ny - 1, int(std::ceil((c.y + r - o.y) / grid.hy())));
-  };
-  for (int k = 0; k < nd; ++k) {
+  for (int k = 0; k < int(discs.size()); ++k) {
     int i0, i1, j0, j1;
     node_range(discs[k].center_m, discs[k].radius_m, i0, i1, j0, j1);
     for (int j = j0; j <= j1; ++j)
@@ -83,88 +89,76 @@ void LdcSolver::Impl::setup_geometry() {
         }
   }
   if (coarse.set_extra_dirichlet(cond_mask)) ++stats.coarse_factorisations;
+}
 
-  const std::vector<LocalGroup> defs = build_local_groups(grid, discs, p);
-  groups.clear();
-  groups.resize(defs.size());
-  group_of_disc.assign(nd, -1);
-  slot_of_disc.assign(nd, -1);
-  std::fill(owner.begin(), owner.end(), -1);
-  gamma_pts.clear();
+void LdcSolver::Impl::setup_annulus_group(int gi) {
+  Group& gr = groups[gi];
+  const auto& mem = gr.def.members;
   const double hmin = std::min(grid.hx(), grid.hy());
-  const double eps_depth = 1e-9 * hmin;
-  std::vector<double> depth(grid.size(), -1.0);
-  // Annuli claim their coarse nodes first; a finite-difference rectangle that overlaps an annulus
-  // keeps only the rest (both local solutions are valid there, but each node needs one owner
-  // whose local domain contains its whole stencil for the defect).
-  for (int pass = 0; pass < 2; ++pass)
-  for (int gi = 0; gi < int(defs.size()); ++gi) {
-    if ((defs[gi].method == LocalMethod::finite_difference) != (pass == 1)) continue;
-    Group& gr = groups[gi];
-    gr.def = defs[gi];
-    const auto& mem = gr.def.members;
-    for (int m = 0; m < int(mem.size()); ++m) {
-      group_of_disc[mem[m]] = gi;
-      slot_of_disc[mem[m]] = m;
-    }
-    if (gr.def.method == LocalMethod::finite_difference) {
-      const int r = gr.def.refinement;
-      const int cx = gr.def.i1 - gr.def.i0, cy = gr.def.j1 - gr.def.j0;
-      const std::array<bool, 4> neu = {gr.def.i0 == 0 && grid.neumann_x_min(), gr.def.i1 == nx - 1 && grid.neumann_x_max(),
-                                       gr.def.j0 == 0 && grid.neumann_y_min(), gr.def.j1 == ny - 1 && grid.neumann_y_max()};
-      std::vector<FdConductor> cs;
-      for (int k : mem) cs.push_back({false, discs[k].center_m, discs[k].radius_m, {}, {}, discs[k].charge_C_per_m});
-      gr.fd = std::make_unique<FdLocalProblem>(grid.node(gr.def.i0, gr.def.j0), grid.hx() / r, grid.hy() / r, cx * r,
-                                               cy * r, neu, std::move(cs), p.permittivity_F_per_m);
-      // Γ = the sides of the rectangle that are not box sides.
-      const bool open[4] = {gr.def.i0 > 0, gr.def.i1 < nx - 1, gr.def.j0 > 0, gr.def.j1 < ny - 1};
-      for (int j = gr.def.j0; j <= gr.def.j1; ++j)
-        for (int i = gr.def.i0; i <= gr.def.i1; ++i) {
-          const int n = grid.index(i, j);
-          double d = 1e300;
-          if (open[0]) d = std::min(d, (i - gr.def.i0) * grid.hx());
-          if (open[1]) d = std::min(d, (gr.def.i1 - i) * grid.hx());
-          if (open[2]) d = std::min(d, (j - gr.def.j0) * grid.hy());
-          if (open[3]) d = std::min(d, (gr.def.j1 - j) * grid.hy());
-          if (owner[n] < 0) { owner[n] = gi; depth[n] = d; gr.owned.push_back(n); }
-          if (d < eps_depth) gamma_pts.push_back(grid.node(i, j));
-        }
-    } else {
-      gr.ann.resize(mem.size());
-      gr.samples.resize(mem.size());
-      for (int m = 0; m < int(mem.size()); ++m) {
-        const Disc& d = discs[mem[m]];
-        const double r2 = gr.def.r2[m];
-        gr.samples[m] = AnnulusSolution::samples_for(r2, hmin / p.gamma_points_per_cell);
-        for (int j = 0; j < gr.samples[m]; ++j)
-          gamma_pts.push_back(AnnulusSolution::sample_point(d.center_m, r2, j, gr.samples[m]));
-        int i0, i1, j0, j1;
-        node_range(d.center_m, r2, i0, i1, j0, j1);
-        for (int j = j0; j <= j1; ++j)
-          for (int i = i0; i <= i1; ++i) {
-            const int n = grid.index(i, j);
-            const double dd = r2 - norm(grid.node(i, j) - d.center_m);
-            if (dd < 0) continue;
-            if (owner[n] < 0) { owner[n] = gi; gr.owned.push_back(n); }
-            if (owner[n] == gi) depth[n] = std::max(depth[n], dd);
-          }
+  gr.ann.resize(mem.size());
+  gr.samples.resize(mem.size());
+  for (int m = 0; m < int(mem.size()); ++m) {
+    const Disc& d = discs[mem[m]];
+    const double r2 = gr.def.r2[m];
+    gr.samples[m] = AnnulusSolution::samples_for(r2, hmin / p.gamma_points_per_cell);
+    for (int j = 0; j < gr.samples[m]; ++j) gamma_pts.push_back(AnnulusSolution::sample_point(d.center_m, r2, j, gr.samples[m]));
+    int i0, i1, j0, j1;
+    node_range(d.center_m, r2, i0, i1, j0, j1);
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const int n = grid.index(i, j);
+        const double dd = r2 - norm(grid.node(i, j) - d.center_m);
+        if (dd < 0) continue;
+        if (owner[n] < 0) { owner[n] = gi; gr.owned.push_back(n); }
+        if (owner[n] == gi) depth[n] = std::max(depth[n], dd);
       }
-      if (gr.def.method == LocalMethod::schwarz) {
-        std::vector<Disc> ds;
-        for (int k : mem) ds.push_back(discs[k]);
-        gr.schwarz = std::make_unique<SchwarzSolver>(ds, gr.def.r2, gr.samples);
-      }
-    }
   }
-  // Defect region: whole stencil inside the local domain, farther than safety_m from Γ.
+  if (gr.def.method == LocalMethod::schwarz) {
+    std::vector<Disc> ds;
+    for (int k : mem) ds.push_back(discs[k]);
+    gr.schwarz = std::make_unique<SchwarzSolver>(ds, gr.def.r2, gr.samples);
+  }
+}
+
+void LdcSolver::Impl::setup_fd_group(int gi) {
+  Group& gr = groups[gi];
+  const LocalGroup& g = gr.def;
+  const int nx = grid.nx(), ny = grid.ny(), r = g.refinement;
+  const std::array<bool, 4> neu = {g.i0 == 0 && grid.neumann_x_min(), g.i1 == nx - 1 && grid.neumann_x_max(),
+                                   g.j0 == 0 && grid.neumann_y_min(), g.j1 == ny - 1 && grid.neumann_y_max()};
+  std::vector<FdConductor> cs;
+  for (int k : g.members) cs.push_back({false, discs[k].center_m, discs[k].radius_m, {}, {}, discs[k].charge_C_per_m});
+  gr.fd = std::make_unique<FdLocalProblem>(grid.node(g.i0, g.j0), grid.hx() / r, grid.hy() / r, (g.i1 - g.i0) * r,
+                                           (g.j1 - g.j0) * r, neu, std::move(cs), p.permittivity_F_per_m);
+  // Γ = the sides of the rectangle that are not box sides.
+  const bool open[4] = {g.i0 > 0, g.i1 < nx - 1, g.j0 > 0, g.j1 < ny - 1};
+  const double eps_depth = 1e-9 * std::min(grid.hx(), grid.hy());
+  for (int j = g.j0; j <= g.j1; ++j)
+    for (int i = g.i0; i <= g.i1; ++i) {
+      const int n = grid.index(i, j);
+      double d = 1e300;
+      if (open[0]) d = std::min(d, (i - g.i0) * grid.hx());
+      if (open[1]) d = std::min(d, (g.i1 - i) * grid.hx());
+      if (open[2]) d = std::min(d, (j - g.j0) * grid.hy());
+      if (open[3]) d = std::min(d, (g.j1 - j) * grid.hy());
+      if (owner[n] < 0) { owner[n] = gi; depth[n] = d; gr.owned.push_back(n); }
+      if (d < eps_depth) gamma_pts.push_back(grid.node(i, j));
+    }
+}
+
+// Defect region (eqs. 3.2.5, 3.2.8): whole stencil inside the node's own local domain, and
+// farther than safety_m from Γ.
+void LdcSolver::Impl::select_defect_nodes() {
+  const int nx = grid.nx(), ny = grid.ny();
+  const double eps_depth = 1e-9 * std::min(grid.hx(), grid.hy());
   for (int gi = 0; gi < int(groups.size()); ++gi) {
     Group& gr = groups[gi];
     for (int n : gr.owned) {
       if (coarse.is_dirichlet(n) || depth[n] <= p.safety_m + eps_depth) continue;
       const int i = n % nx, j = n / nx;
-      bool inside = true;
       const int ni[4] = {i + 1 < nx ? i + 1 : i - 1, i > 0 ? i - 1 : i + 1, i, i};
       const int nj[4] = {j, j, j + 1 < ny ? j + 1 : j - 1, j > 0 ? j - 1 : j + 1};
+      bool inside = true;
       for (int s = 0; s < 4 && inside; ++s) {
         const int q = grid.index(ni[s], nj[s]);
         inside = owner[q] == gi || grid.box_dirichlet(q);
@@ -172,6 +166,34 @@ void LdcSolver::Impl::setup_geometry() {
       if (inside) gr.defect.push_back(n);
     }
   }
+}
+
+void LdcSolver::Impl::setup_geometry() {
+  const int nd = int(discs.size());
+  mark_conductor_nodes();
+  const std::vector<LocalGroup> defs = build_local_groups(grid, discs, p);
+  groups.clear();
+  groups.resize(defs.size());
+  group_of_disc.assign(nd, -1);
+  slot_of_disc.assign(nd, -1);
+  std::fill(owner.begin(), owner.end(), -1);
+  depth.assign(grid.size(), -1.0);
+  gamma_pts.clear();
+  for (int gi = 0; gi < int(defs.size()); ++gi) {
+    groups[gi].def = defs[gi];
+    for (int m = 0; m < int(defs[gi].members.size()); ++m) {
+      group_of_disc[defs[gi].members[m]] = gi;
+      slot_of_disc[defs[gi].members[m]] = m;
+    }
+  }
+  // Annuli claim their coarse nodes first; a finite-difference rectangle that overlaps an annulus
+  // keeps only the rest (both local solutions are valid there, but each node needs one owner
+  // whose local domain contains its whole stencil for the defect).
+  for (int gi = 0; gi < int(defs.size()); ++gi)
+    if (defs[gi].method != LocalMethod::finite_difference) setup_annulus_group(gi);
+  for (int gi = 0; gi < int(defs.size()); ++gi)
+    if (defs[gi].method == LocalMethod::finite_difference) setup_fd_group(gi);
+  select_defect_nodes();
   gamma_prev.assign(gamma_pts.size(), 0.0);
   gamma_cur.assign(gamma_pts.size(), 0.0);
 }

@@ -36,7 +36,7 @@ std::vector<double> square_hole_kappa(double safety, int iterations) {
   const Params p = problem_381(20);
   const CoarseGrid grid(p);
   CoarseSolver coarse(grid);
-  const int nx = grid.nx(), lo = 5, hi = 15;  // Ωl = (0.25, 0.75)^2 in coarse node indices
+  const int lo = 5, hi = 15;  // Ωl = (0.25, 0.75)^2 in coarse node indices
   auto in_hole = [&](int i, int j) { return i >= 9 && i <= 11 && j >= 9 && j <= 11; };  // (0.45,0.55)^2
   std::vector<std::uint8_t> mask(grid.size(), 0);
   for (int j = 9; j <= 11; ++j)
@@ -73,7 +73,6 @@ std::vector<double> square_hole_kappa(double safety, int iterations) {
         source[grid.index(i, j)] = grid.laplacian(w, i, j);
       }
   }
-  (void)nx;
   return kappa;
 }
 
