@@ -1,7 +1,8 @@
 // `nipdem ldc verify [--json]`: reruns the LDC verification problems of thesis §3.8-3.10.
-// `nipdem ldc solve SETUP.json [--json]`: solves one disc configuration (see docs/ldc.md).
+// `nipdem ldc solve SETUP.{json,toml} [--json]`: solves one disc configuration (see docs/ldc.md).
 #include <cstdio>
-#include <fstream>
+#include <sstream>
+#include <toml++/toml.h>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -117,8 +118,18 @@ nipdem::ldc::Params read_params(const json& j, std::vector<nipdem::ldc::Disc>& d
 void run_solve(const std::string& path, bool as_json) {
   using namespace nipdem::ldc;
   json j;
+  const std::string text = nipdem::io::read_file(path);
+  const bool is_toml = path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
   try {
-    j = json::parse(nipdem::io::read_file(path));
+    if (is_toml) {  // same keys as the JSON form; [[discs]] array of tables
+      std::ostringstream os;
+      os << toml::json_formatter{toml::parse(text, path)};
+      j = json::parse(os.str());
+    } else {
+      j = json::parse(text);
+    }
+  } catch (const toml::parse_error& e) {
+    nipdem::throw_input(path, "", "", std::string("invalid TOML: ") + std::string(e.description()));
   } catch (const json::exception& e) {
     nipdem::throw_input(path, "", "", std::string("invalid JSON: ") + e.what());
   }
@@ -155,10 +166,10 @@ nipdem::cli::Register reg([](CLI::App& app) {
   ver->add_flag("--json", *vjson, "print one JSON object");
   ver->callback([vjson] { run_verify(*vjson); });
 
-  auto* sol = ldc->add_subcommand("solve", "Solve one disc configuration given in a JSON setup file");
+  auto* sol = ldc->add_subcommand("solve", "Solve one disc configuration given in a JSON or TOML setup file");
   struct Opts { std::string path; bool json = false; };
   auto opts = std::make_shared<Opts>();
-  sol->add_option("setup", opts->path, "setup file (JSON, see docs/ldc.md)")->required();
+  sol->add_option("setup", opts->path, "setup file (.json or .toml, see docs/ldc.md)")->required();
   sol->add_flag("--json", opts->json, "print one JSON object");
   sol->callback([opts] { run_solve(opts->path, opts->json); });
 });

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -47,5 +49,22 @@ TEST(LdcCli, VerifyJsonHasContractKeys) {
 TEST(LdcCli, MissingSetupFileExitsTwo) {
   int rc = -1;
   run("ldc solve /nonexistent/nipdem_ldc_setup.json", &rc);
+  EXPECT_EQ(rc, 2);
+}
+
+TEST(LdcCli, SolveReadsToml) {
+  // Same keys as the JSON setup; a grounded-box disc gives one JSON object with its potential.
+  const auto path = std::filesystem::temp_directory_path() / "nipdem_test_ldc_setup.toml";
+  std::ofstream(path) << "permittivity_F_per_m = 1.0\n[box]\ncells_x = 40\ncells_y = 40\n"
+                         "[[discs]]\nx_m = 0.5\ny_m = 0.5\nradius_m = 0.05\ncharge_C_per_m = 1.0\n";
+  int rc = -1;
+  const auto j = nlohmann::json::parse(run("ldc solve " + path.string() + " --json", &rc));
+  EXPECT_EQ(rc, 0);
+  ASSERT_EQ(j["discs"].size(), 1u);
+  // g = q/(2π) ln(r_in/R) with the inner radius 0.5390 of the unit square: 0.3784 (2 % tolerance:
+  // coarse grid H = 1/40 with R = 2H).
+  EXPECT_NEAR(j["discs"][0]["potential_V"].get<double>(), 0.3784, 0.02 * 0.3784);
+  std::ofstream(path) << "x = [";
+  run("ldc solve " + path.string(), &rc);
   EXPECT_EQ(rc, 2);
 }
