@@ -1,0 +1,176 @@
+// `nipdem ldc verify [--json]`: reruns the LDC verification problems of thesis §3.8-3.10.
+// `nipdem ldc solve SETUP.{json,toml} [--json]`: solves one disc configuration (see docs/ldc.md).
+#include <cstdio>
+#include <sstream>
+#include <toml++/toml.h>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/solvers/ldc/ldc_solver.hpp"
+#include "nipdem/solvers/ldc/verify.hpp"
+#include "registry.hpp"
+
+namespace {
+using nlohmann::json;
+namespace lv = nipdem::ldc::verify;
+
+json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+void run_verify(bool as_json) {
+  const auto t31 = lv::table_3_1();
+  const auto t32 = lv::table_3_2();
+  const auto t33 = lv::table_3_3();
+  const auto t34 = lv::table_3_4();
+  const auto f36 = lv::fig_3_6();
+  if (as_json) {
+    json j;
+    j["table_3_1"] = json::array();
+    for (const auto& r : t31) j["table_3_1"].push_back({{"i", r.i}, {"kappa_eps0", r.kappa_eps0}, {"kappa_eps005", r.kappa_eps005}});
+    j["table_3_2"] = json::array();
+    for (const auto& r : t32) j["table_3_2"].push_back({{"H", r.H}, {"i", r.i}, {"delta", r.delta}, {"rho", opt(r.rho)}});
+    j["table_3_3"] = json::array();
+    for (const auto& r : t33) j["table_3_3"].push_back({{"H", r.H}, {"i", r.i}, {"kappa", r.kappa}, {"sigma", opt(r.sigma)}});
+    j["table_3_4"] = json::array();
+    for (const auto& r : t34) j["table_3_4"].push_back({{"i", r.i}, {"nu", r.nu}, {"tau", opt(r.tau)}});
+    j["fig_3_6"] = {{"charge_error_1", f36.charge_error_1}, {"charge_error_2", f36.charge_error_2}};
+    nipdem::cli::print_json(j.dump());
+    return;
+  }
+  std::printf("Table 3.1  kappa_i, square hole, H = 1/20, h = H/2\n%4s %12s %12s\n", "i", "eps=0", "eps=0.05");
+  for (const auto& r : t31) std::printf("%4d %12.3e %12.3e\n", r.i, r.kappa_eps0, r.kappa_eps005);
+  std::printf("\nTable 3.2  delta_i on Gamma, analytic local solution\n%8s %4s %12s %12s\n", "H", "i", "delta", "rho");
+  for (const auto& r : t32) {
+    std::printf("%8s %4d %12.3e ", ("1/" + std::to_string(int(std::lround(1 / r.H)))).c_str(), r.i, r.delta);
+    if (r.rho) std::printf("%12.3e\n", *r.rho); else std::printf("%12s\n", "-");
+  }
+  std::printf("\nTable 3.3  kappa_i and sigma = kappa(H/2)/kappa(H)\n%8s %4s %12s %12s\n", "H", "i", "kappa", "sigma");
+  for (const auto& r : t33) {
+    std::printf("%8s %4d %12.3e ", ("1/" + std::to_string(int(std::lround(1 / r.H)))).c_str(), r.i, r.kappa);
+    if (r.sigma) std::printf("%12.3e\n", *r.sigma); else std::printf("%12s\n", "-");
+  }
+  std::printf("\nTable 3.4  Schwarz process, nu_i and tau_i\n%4s %12s %12s\n", "i", "nu", "tau");
+  for (const auto& r : t34) {
+    std::printf("%4d %12.3e ", r.i, r.nu);
+    if (r.tau) std::printf("%12.3e\n", *r.tau); else std::printf("%12s\n", "-");
+  }
+  std::printf("\nFig. 3.6  finite-difference local solution, relative charge error\n");
+  std::printf("  disc 1: %.3e   disc 2: %.3e   (g1 = %.6f, g2 = %.6f)\n", f36.charge_error_1, f36.charge_error_2, f36.g1,
+              f36.g2);
+}
+
+// Reads a setup file (JSON; keys in docs/ldc.md). Unknown or wrong-typed keys are InputErrors.
+nipdem::ldc::Params read_params(const json& j, std::vector<nipdem::ldc::Disc>& discs, const std::string& where) {
+  using namespace nipdem::ldc;
+  Params p;
+  auto num = [&](const json& o, const char* key, double& v) {
+    if (!o.contains(key)) return;
+    if (!o[key].is_number()) nipdem::throw_input(where, key, o[key].dump(), "must be a number");
+    v = o[key].get<double>();
+  };
+  auto integer = [&](const json& o, const char* key, int& v) {
+    if (!o.contains(key)) return;
+    if (!o[key].is_number_integer()) nipdem::throw_input(where, key, o[key].dump(), "must be an integer");
+    v = o[key].get<int>();
+  };
+  if (!j.is_object()) nipdem::throw_input(where, "", "", "setup must be a JSON object");
+  if (j.contains("box")) {
+    const json& b = j["box"];
+    num(b, "x_min_m", p.x_min_m);
+    num(b, "x_max_m", p.x_max_m);
+    num(b, "y_min_m", p.y_min_m);
+    num(b, "y_max_m", p.y_max_m);
+    integer(b, "cells_x", p.cells_x);
+    integer(b, "cells_y", p.cells_y);
+  }
+  if (j.contains("boundary")) {
+    const json& b = j["boundary"];
+    for (auto [name, side] : {std::pair{"bottom", &p.bottom}, {"top", &p.top}, {"left", &p.left}, {"right", &p.right}}) {
+      if (!b.contains(name)) continue;
+      const json& s = b[name];
+      const std::string kind = s.value("kind", "dirichlet");
+      if (kind == "dirichlet") side->kind = SideKind::dirichlet;
+      else if (kind == "neumann") side->kind = SideKind::neumann;
+      else nipdem::throw_input(where, std::string("boundary.") + name + ".kind", kind, "unknown kind", "dirichlet, neumann");
+      num(s, "value_V", side->value_V);
+    }
+  }
+  num(j, "permittivity_F_per_m", p.permittivity_F_per_m);
+  num(j, "local_radius_factor", p.local_radius_factor);
+  num(j, "safety_m", p.safety_m);
+  num(j, "tolerance", p.tolerance);
+  integer(j, "max_iterations", p.max_iterations);
+  integer(j, "fd_refinement", p.fd_refinement);
+  if (!j.contains("discs") || !j["discs"].is_array()) nipdem::throw_input(where, "discs", "", "missing array of discs");
+  for (const json& d : j["discs"]) {
+    Disc disc;
+    num(d, "x_m", disc.center_m.x);
+    num(d, "y_m", disc.center_m.y);
+    num(d, "radius_m", disc.radius_m);
+    num(d, "charge_C_per_m", disc.charge_C_per_m);
+    discs.push_back(disc);
+  }
+  return p;
+}
+
+void run_solve(const std::string& path, bool as_json) {
+  using namespace nipdem::ldc;
+  json j;
+  const std::string text = nipdem::io::read_file(path);
+  const bool is_toml = path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
+  try {
+    if (is_toml) {  // same keys as the JSON form; [[discs]] array of tables
+      std::ostringstream os;
+      os << toml::json_formatter{toml::parse(text, path)};
+      j = json::parse(os.str());
+    } else {
+      j = json::parse(text);
+    }
+  } catch (const toml::parse_error& e) {
+    nipdem::throw_input(path, "", "", std::string("invalid TOML: ") + std::string(e.description()));
+  } catch (const json::exception& e) {
+    nipdem::throw_input(path, "", "", std::string("invalid JSON: ") + e.what());
+  }
+  std::vector<Disc> discs;
+  const Params p = read_params(j, discs, path);
+  LdcSolver solver(p);
+  const SolveStats& st = solver.solve(discs);
+  json out;
+  out["iterations"] = st.iterations;
+  out["converged"] = st.converged;
+  out["discs"] = json::array();
+  for (int k = 0; k < solver.disc_count(); ++k) {
+    const auto f = solver.force(k);
+    out["discs"].push_back({{"potential_V", solver.potential(k)},
+                            {"force_N_per_m", {f.x, f.y}},
+                            {"method", to_string(solver.method(k))}});
+  }
+  if (as_json) {
+    nipdem::cli::print_json(out.dump());
+    return;
+  }
+  std::printf("LDC: %d iterations, converged: %s\n%4s %14s %14s %14s  %s\n", st.iterations, st.converged ? "yes" : "no",
+              "k", "g [V]", "Fx [N/m]", "Fy [N/m]", "local method");
+  for (int k = 0; k < solver.disc_count(); ++k) {
+    const auto f = solver.force(k);
+    std::printf("%4d %14.6e %14.6e %14.6e  %s\n", k, solver.potential(k), f.x, f.y, to_string(solver.method(k)));
+  }
+}
+
+nipdem::cli::Register reg([](CLI::App& app) {
+  auto* ldc = nipdem::cli::group(app, "ldc", "Local defect correction electrostatic solver (thesis ch. 3)");
+  auto* ver = ldc->add_subcommand("verify", "Rerun the verification problems of thesis 3.8-3.10");
+  auto vjson = std::make_shared<bool>(false);
+  ver->add_flag("--json", *vjson, "print one JSON object");
+  ver->callback([vjson] { run_verify(*vjson); });
+
+  auto* sol = ldc->add_subcommand("solve", "Solve one disc configuration given in a JSON or TOML setup file");
+  struct Opts { std::string path; bool json = false; };
+  auto opts = std::make_shared<Opts>();
+  sol->add_option("setup", opts->path, "setup file (.json or .toml, see docs/ldc.md)")->required();
+  sol->add_flag("--json", opts->json, "print one JSON object");
+  sol->callback([opts] { run_solve(opts->path, opts->json); });
+});
+}  // namespace

@@ -1,0 +1,82 @@
+#include "nipdem/solvers/ldc/problem.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "nipdem/core/error.hpp"
+
+namespace nipdem::ldc {
+
+const char* to_string(LocalMethod m) {
+  switch (m) {
+    case LocalMethod::analytic: return "analytic";
+    case LocalMethod::schwarz: return "schwarz";
+    case LocalMethod::finite_difference: return "finite_difference";
+  }
+  return "?";
+}
+
+void validate(const Params& p) {
+  const std::string where = "ldc";
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  if (!(p.x_max_m > p.x_min_m))
+    throw_input(where, "x_max_m", fmt::format("{}", p.x_max_m), "box has zero or negative width",
+                fmt::format("> x_min_m = {}", p.x_min_m));
+  if (!(p.y_max_m > p.y_min_m))
+    throw_input(where, "y_max_m", fmt::format("{}", p.y_max_m), "box has zero or negative height",
+                fmt::format("> y_min_m = {}", p.y_min_m));
+  if (p.cells_x < 2) throw_input(where, "cells_x", std::to_string(p.cells_x), "coarse grid too small", ">= 2");
+  if (p.cells_y < 2) throw_input(where, "cells_y", std::to_string(p.cells_y), "coarse grid too small", ">= 2");
+  const double ratio = p.hx() / p.hy();
+  if (ratio > 4.0 || ratio < 0.25)
+    throw_input(where, "cells_x/cells_y", fmt::format("hx/hy = {}", ratio), "coarse cells too elongated",
+                "0.25 <= hx/hy <= 4");
+  require_positive(where, "permittivity_F_per_m", p.permittivity_F_per_m);
+  require_range(where, "local_radius_factor", p.local_radius_factor, 1.2, inf);
+  require_range(where, "local_min_cells", p.local_min_cells, 1.0, inf);
+  require_range(where, "gamma_points_per_cell", p.gamma_points_per_cell, 0.25, 64.0);
+  require_range(where, "fd_refinement", p.fd_refinement, 1, 64);
+  require_range(where, "fd_min_points_per_radius", p.fd_min_points_per_radius, 1.0, 64.0);
+  require_range(where, "safety_m", p.safety_m, 0.0, inf);
+  require_range(where, "tolerance", p.tolerance, 1e-15, 1.0);
+  require_range(where, "max_iterations", p.max_iterations, 1, 1e6);
+  require_range(where, "schwarz_max_iterations", p.schwarz_max_iterations, 1, 1e6);
+  require_range(where, "schwarz_tolerance", p.schwarz_tolerance, 1e-16, 1.0);
+  require_range(where, "initial_potential_V", p.initial_potential_V, -inf, inf);
+  if (p.bottom.kind == SideKind::neumann && p.top.kind == SideKind::neumann && p.left.kind == SideKind::neumann &&
+      p.right.kind == SideKind::neumann)
+    throw_input(where, "boundary", "all sides Neumann", "the potential would be undefined up to a constant",
+                "at least one Dirichlet side");
+  for (const auto* s : {&p.bottom, &p.top, &p.left, &p.right})
+    if (!std::isfinite(s->value_V)) throw_input(where, "boundary value_V", fmt::format("{}", s->value_V), "not finite");
+}
+
+void validate_discs(const Params& p, std::span<const Disc> discs) {
+  const std::string where = "ldc";
+  for (std::size_t k = 0; k < discs.size(); ++k) {
+    const Disc& d = discs[k];
+    const std::string key = fmt::format("disc[{}]", k);
+    if (!std::isfinite(d.center_m.x) || !std::isfinite(d.center_m.y))
+      throw_input(where, key + ".center_m", fmt::format("({}, {})", d.center_m.x, d.center_m.y), "not finite");
+    if (!(d.radius_m > 0.0) || !std::isfinite(d.radius_m))
+      throw_input(where, key + ".radius_m", fmt::format("{}", d.radius_m), "radius must be positive", "> 0");
+    if (!std::isfinite(d.charge_C_per_m))
+      throw_input(where, key + ".charge_C_per_m", fmt::format("{}", d.charge_C_per_m), "not finite");
+    const double r = d.radius_m;
+    if (d.center_m.x - r <= p.x_min_m || d.center_m.x + r >= p.x_max_m || d.center_m.y - r <= p.y_min_m ||
+        d.center_m.y + r >= p.y_max_m)
+      throw_input(where, key + ".center_m", fmt::format("({}, {}) radius {}", d.center_m.x, d.center_m.y, r),
+                  "disc is not strictly inside the box",
+                  fmt::format("[{}, {}] x [{}, {}]", p.x_min_m, p.x_max_m, p.y_min_m, p.y_max_m));
+    for (std::size_t j = 0; j < k; ++j) {
+      const double dist = norm(d.center_m - discs[j].center_m);
+      if (dist <= r + discs[j].radius_m)
+        throw_input(where, key, fmt::format("centre distance {} to disc[{}]", dist, j), "discs overlap or touch",
+                    fmt::format("> sum of radii = {}", r + discs[j].radius_m));
+    }
+  }
+}
+
+}  // namespace nipdem::ldc
