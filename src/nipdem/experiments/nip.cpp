@@ -34,23 +34,20 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   p.skin = 0.1 * cfg_.size.d50;
   p.threads = cfg_.threads;
 
-  geometry::Wall roller;
-  roller.kind = geometry::Wall::Kind::cylinder;
-  roller.name = "imaging_roller";
-  roller.centre = roller_centre();
-  roller.radius = cfg_.roller_radius;
-  // Surface at the top moves towards +x: clockwise rotation (omega < 0).
-  roller.omega = -cfg_.roller_speed / cfg_.roller_radius;
-  roller.interaction = 1;
+  // Both rollers turn clockwise: the roller's top moves towards +x, the drum's bottom towards -x.
+  auto cylinder = [](const char* name, Vec2 centre, double radius, double surface_speed, int interaction) {
+    geometry::Wall w;
+    w.kind = geometry::Wall::Kind::cylinder;
+    w.name = name;
+    w.centre = centre;
+    w.radius = radius;
+    w.omega = -surface_speed / radius;
+    w.interaction = interaction;
+    return w;
+  };
+  geometry::Wall roller = cylinder("imaging_roller", roller_centre(), cfg_.roller_radius, cfg_.roller_speed, 1);
   if (cfg_.roughness && cfg_.rough_height > 0.0) geometry::set_pyramid_roughness(roller, cfg_.rough_height, cfg_.rough_base, cfg_.rough_spacing);
-  geometry::Wall drum;
-  drum.kind = geometry::Wall::Kind::cylinder;
-  drum.name = "di_drum";
-  drum.centre = drum_centre();
-  drum.radius = cfg_.drum_radius;
-  // Surface at the bottom moves towards -x: omega * R * (+x) at the bottom point => omega < 0.
-  drum.omega = -cfg_.drum_speed / cfg_.drum_radius;
-  drum.interaction = 2;
+  geometry::Wall drum = cylinder("di_drum", drum_centre(), cfg_.drum_radius, cfg_.drum_speed, 2);
   sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
   if (auto field = make_magnet_field(cfg_.magnet)) sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
   if (cfg_.electric.enabled) {
