@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
