@@ -169,7 +169,10 @@ nipdem::cli::Register reg([](CLI::App& app) {
     csv += "x_m,y_m,Bx_T,By_T,B_T,dBx_dx_T_per_m,dBx_dy_T_per_m,dBy_dx_T_per_m,dBy_dy_T_per_m,mx_Am2,my_Am2,Fx_N,Fy_N,F_N\n";
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;
-    io::Series sb{.label = "|B| [T] x 100"}, sfx{.label = "F_x [nN]"}, sfy{.label = "F_y [nN]"};
+    io::Series sb, sfx, sfy;
+    sb.label = "|B| [T] x 100";
+    sfx.label = "F_x [nN]";
+    sfy.label = "F_y [nN]";
     for (int i = 0; i < lo->n; ++i) {
       const double x = lo->x0 + (lo->x1 - lo->x0) * i / (lo->n - 1);
       const auto smp = s.field->at({x, lo->y});
@@ -192,8 +195,10 @@ nipdem::cli::Register reg([](CLI::App& app) {
     // The picture of the same data (thesis fig. 2.12 analogue), next to the CSV.
     std::filesystem::path png = lo->out;
     png.replace_extension(".png");
-    io::PlotSpec plot{.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius * 1e6, lo->y * 1e6),
-                      .x_label = "x [um] (magnet edge = 0)", .y_label = "force [nN], |B| [T/100]"};
+    io::PlotSpec plot;
+    plot.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius * 1e6, lo->y * 1e6);
+    plot.x_label = "x [um] (magnet edge = 0)";
+    plot.y_label = "force [nN], |B| [T/100]";
     plot.series = {sb, sfx, sfy};
     io::write_plot_png(png, plot);
     if (lo->c.json) {

@@ -118,8 +118,10 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     rows.push_back(row);
   }
   io::write_file_atomic(o.out / "front_position.csv", csv);
-  io::PlotSpec plot{.title = "Clean-state front position (thesis §5.1)", .x_label = "gap w_h [µm]",
-                    .y_label = "front position x [µm] (magnet edge = 0)"};
+  io::PlotSpec plot;
+  plot.title = "Clean-state front position (thesis §5.1)";
+  plot.x_label = "gap w_h [µm]";
+  plot.y_label = "front position x [µm] (magnet edge = 0)";
   for (auto& [v, s] : by_speed) plot.series.push_back(s);
   if (!plot.series.empty() && !plot.series[0].x.empty()) io::write_plot_png(o.out / "front_position.png", plot);
   return {{"experiment", "front-position"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
@@ -171,7 +173,9 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   if (!sum.is_root) return {};
   json rows = json::array();
   std::string csv = "r,removed,time_s,removed_per_100ms,reduction_speed_m_per_s,reduction_speed_stderr_m_per_s\n";
-  io::Series s{.label = "removed in the observation time", .markers = true};
+  io::Series s;
+  s.label = "removed in the observation time";
+  s.markers = true;
   for (const auto& rec : sum.records) {
     if (!rec.ok) continue;
     json row = rec.result;
@@ -191,8 +195,12 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   }
   io::write_file_atomic(o.out / "reduction.csv", csv);
   if (!s.x.empty()) {
-    io::PlotSpec p{.title = "Reduction experiment (thesis §4.6, fig. 4.25 analogue)", .x_label = "r = F_coh / F_adh",
-                   .y_label = "particles removed", .log_x = s.x.size() > 1 && s.x.front() > 0, .log_y = true};
+    io::PlotSpec p;
+    p.title = "Reduction experiment (thesis §4.6, fig. 4.25 analogue)";
+    p.x_label = "r = F_coh / F_adh";
+    p.y_label = "particles removed";
+    p.log_x = s.x.size() > 1 && s.x.front() > 0;
+    p.log_y = true;
     p.series.push_back(s);
     io::write_plot_png(o.out / "reduction.png", p);
   }
