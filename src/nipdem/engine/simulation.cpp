@@ -161,28 +161,33 @@ void Simulation::add_force(std::shared_ptr<BodyForce> f) {
   forces_valid_ = false;
 }
 
-void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
-  for (std::size_t b = b0; b < b1; ++b) {
-    const int first = b_.first_disc[b], nd = b_.n_discs[b];
-    const double X = b_.x[b], Y = b_.y[b];
-    if (nd == 1 && d_.ox[first] == 0.0 && d_.oy[first] == 0.0) {
-      d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
-      continue;
-    }
-    const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
-    for (int k = first; k < first + nd; ++k) {
-      const double wx = c * d_.ox[k] - s * d_.oy[k];
-      const double wy = s * d_.ox[k] + c * d_.oy[k];
-      d_.wx[k] = wx; d_.wy[k] = wy;
-      d_.x[k] = X + wx; d_.y[k] = Y + wy;
-    }
+// World positions of the discs of body b from its pose.
+inline void Simulation::place_body(std::size_t b) {
+  const int first = b_.first_disc[b], nd = b_.n_discs[b];
+  const double X = b_.x[b], Y = b_.y[b];
+  if (nd == 1 && d_.ox[first] == 0.0 && d_.oy[first] == 0.0) {
+    d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
+    return;
+  }
+  const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
+  for (int k = first; k < first + nd; ++k) {
+    const double wx = c * d_.ox[k] - s * d_.oy[k];
+    const double wy = s * d_.ox[k] + c * d_.oy[k];
+    d_.wx[k] = wx; d_.wy[k] = wy;
+    d_.x[k] = X + wx; d_.y[k] = Y + wy;
   }
 }
 
-void Simulation::ensure_neighbor_list() {
+void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
+  for (std::size_t b = b0; b < b1; ++b) place_body(b);
+}
+
+// moved: -1 = unknown (check every disc), 0/1 = the caller already checked (step() does it
+// in the drift loop).
+void Simulation::ensure_neighbor_list(int moved) {
   if (structure_changed_) {
     nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
-  } else if (nlist_.needs_rebuild(d_.x, d_.y)) {
+  } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
     nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
   } else {
     return;
@@ -298,8 +303,14 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   nc_out = nc;
 }
 
-void Simulation::pair_forces() {
+// Pair forces, wall forces and their sum per body, in one parallel region: pack the discs,
+// run the pair kernel on each thread's rows, reduce the thread buffers per disc and add the
+// wall forces of that disc, then sum per body.
+void Simulation::contact_forces() {
   const int n = static_cast<int>(d_.x.size());
+  const int nb = static_cast<int>(b_.x.size());
+  const bool has_walls = !walls_.empty();
+  if (has_walls) prepare_walls();
   const int nt = params_.threads;
   const bool adh = params_.interactions[0].adhesion.hamaker_J != 0.0;
   const bool periodic = params_.periodic_x;
@@ -340,6 +351,7 @@ void Simulation::pair_forces() {
       else pair_rows<false, false>(lo, split_[t + 1], buf.data(), fa, nc);
     }
     thread_nc_[t] = nc;
+    std::int64_t wall_nc = 0;
 #pragma omp barrier
     // Reduce in fixed thread order (bitwise reproducible for a given thread count), each
     // thread over its own slice of discs, adding only the buffers whose window covers it.
@@ -353,111 +365,112 @@ void Simulation::pair_forces() {
         if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
+      if (has_walls) wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
     }
+    thread_nc_[t] += wall_nc;
+    // (implicit barrier: a body's discs may lie in another thread's slice)
+#pragma omp for schedule(static)
+    for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
   }
   std::int64_t total = 0;
   for (auto c : thread_nc_) total += c;
   n_contacts_ = total;
 }
 
-void Simulation::wall_forces() {
-  if (walls_.empty()) return;
-  const std::size_t n = d_.x.size();
+void Simulation::prepare_walls() {
   const std::size_t nw = walls_.size();
-  const double dt = params_.dt;
   wall_reach_.resize(nw);
   for (std::size_t w = 0; w < nw; ++w) {
     const auto& ad = params_.interactions[walls_[w].interaction].adhesion;
     wall_reach_[w] = ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0;
   }
   if (static_cast<int>(thread_hits_.size()) < params_.threads) thread_hits_.resize(params_.threads);
-  std::int64_t nc_total = 0;
-#pragma omp parallel num_threads(params_.threads) reduction(+ : nc_total)
-  {
-    std::vector<geometry::WallHit>& hits = thread_hits_[omp_get_thread_num()];
-    std::int64_t new_key[kWallSlots];
-    double new_eta[kWallSlots];
-    std::uint8_t new_sl[kWallSlots];
-#pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 c{d_.x[i], d_.y[i]};
-      const double r = d_.r[i];
-      int nnew = 0;
-      double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
-      bool touched = false;
-      for (std::size_t w = 0; w < nw; ++w) {
-        const auto& wall = walls_[w];
-        if (!wall.may_touch(c, r, wall_reach_[w])) continue;  // most discs: no trigonometry, no query
-        const Interaction& ia = params_.interactions[wall.interaction];
-        hits.clear();
-        wall.query(c, r, wall_reach_[w], hits);
-        const int bi = d_.body[i];
-        for (const auto& h : hits) {
-          touched = true;
-          double fnx = 0, fny = 0;
-          const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
-          if (h.gap < 0.0) {
-            ++nc_total;
-            const double overlap = -h.gap;
-            const double l = r - 0.5 * overlap;
-            const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
-            const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
-            const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
-            const double vn = vrx * h.normal.x + vry * h.normal.y;
-            const double vt = -vrx * h.normal.y + vry * h.normal.x;
-            const double m = b_.mass[bi];
-            const double fn = models::normal_force(ia.contact, overlap, vn, m);
-            const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
-            TangentialState st{};
-            for (int q = 0; q < kWallSlots; ++q) {
-              if (d_.wall_key[i * kWallSlots + q] == key) {
-                st.eta = d_.wall_eta[i * kWallSlots + q];
-                st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
-                break;
-              }
-            }
-            const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
-            if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
-              new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
-            }
-            fnx = fn * h.normal.x - ft * h.normal.y;
-            fny = fn * h.normal.y + ft * h.normal.x;
-            tq += -l * ft;
-          }
-          fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
-          fax -= fa * h.normal.x; fay -= fa * h.normal.y;
-          fx += fnx; fy += fny;
-        }
-      }
-      // Slots are filled from 0, so an empty slot 0 means nothing to clear.
-      if (nnew > 0 || d_.wall_key[i * kWallSlots] != -1) {
-        for (int q = 0; q < kWallSlots; ++q) {
-          d_.wall_key[i * kWallSlots + q] = q < nnew ? new_key[q] : -1;
-          d_.wall_eta[i * kWallSlots + q] = q < nnew ? new_eta[q] : 0.0;
-          d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
-        }
-      }
-      if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay; }
-    }
-  }
-  n_contacts_ += nc_total;
 }
 
-void Simulation::reduce_to_bodies() {
-  const std::size_t nb = b_.x.size();
-  const Vec2 g = params_.gravity;
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-  for (std::size_t b = 0; b < nb; ++b) {
-    const int first = b_.first_disc[b], nd = b_.n_discs[b];
-    double fx = 0, fy = 0, tq = 0;
-    for (int k = first; k < first + nd; ++k) {
-      fx += d_.fx[k]; fy += d_.fy[k];
-      tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
+// Wall forces on disc i, added to its force arrays; wall history slots updated.
+void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc) {
+  const std::size_t nw = walls_.size();
+  const double dt = params_.dt;
+  std::int64_t new_key[kWallSlots];
+  double new_eta[kWallSlots];
+  std::uint8_t new_sl[kWallSlots];
+  const Vec2 c{d_.x[i], d_.y[i]};
+  const double r = d_.r[i];
+  int nnew = 0;
+  double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
+  bool touched = false;
+  for (std::size_t w = 0; w < nw; ++w) {
+    const auto& wall = walls_[w];
+    if (!wall.may_touch(c, r, wall_reach_[w])) continue;  // most discs: no trigonometry, no query
+    const Interaction& ia = params_.interactions[wall.interaction];
+    hits.clear();
+    wall.query(c, r, wall_reach_[w], hits);
+    const int bi = d_.body[i];
+    for (const auto& h : hits) {
+      touched = true;
+      double fnx = 0, fny = 0;
+      const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
+      if (h.gap < 0.0) {
+        ++nc;
+        const double overlap = -h.gap;
+        const double l = r - 0.5 * overlap;
+        const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
+        const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
+        const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
+        const double vn = vrx * h.normal.x + vry * h.normal.y;
+        const double vt = -vrx * h.normal.y + vry * h.normal.x;
+        const double m = b_.mass[bi];
+        const double fn = models::normal_force(ia.contact, overlap, vn, m);
+        const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+        TangentialState st{};
+        for (int q = 0; q < kWallSlots; ++q) {
+          if (d_.wall_key[i * kWallSlots + q] == key) {
+            st.eta = d_.wall_eta[i * kWallSlots + q];
+            st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
+            break;
+          }
+        }
+        const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
+        if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
+          new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
+        }
+        fnx = fn * h.normal.x - ft * h.normal.y;
+        fny = fn * h.normal.y + ft * h.normal.x;
+        tq += -l * ft;
+      }
+      fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
+      fax -= fa * h.normal.x; fay -= fa * h.normal.y;
+      fx += fnx; fy += fny;
     }
-    b_.fx[b] = fx + b_.mass[b] * g.x;
-    b_.fy[b] = fy + b_.mass[b] * g.y;
-    b_.torque[b] = tq;
   }
+  // Slots are filled from 0, so an empty slot 0 means nothing to clear.
+  if (nnew > 0 || d_.wall_key[i * kWallSlots] != -1) {
+    for (int q = 0; q < kWallSlots; ++q) {
+      d_.wall_key[i * kWallSlots + q] = q < nnew ? new_key[q] : -1;
+      d_.wall_eta[i * kWallSlots + q] = q < nnew ? new_eta[q] : 0.0;
+      d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
+    }
+  }
+  if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay; }
+}
+
+// Total force and torque about the centre of mass of body b from its discs, plus gravity.
+inline void Simulation::reduce_body(std::size_t b) {
+  const Vec2 g = params_.gravity;
+  const int first = b_.first_disc[b], nd = b_.n_discs[b];
+  double fx = 0, fy = 0, tq = 0;
+  for (int k = first; k < first + nd; ++k) {
+    fx += d_.fx[k]; fy += d_.fy[k];
+    tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
+  }
+  b_.fx[b] = fx + b_.mass[b] * g.x;
+  b_.fy[b] = fy + b_.mass[b] * g.y;
+  b_.torque[b] = tq;
+}
+
+// The body forces of the external providers (serial: their code is not ours).
+void Simulation::provider_forces() {
+  const std::size_t nb = b_.x.size();
   for (std::size_t k = 0; k < forces_.size(); ++k) {
     std::fill(prov_fx_[k].begin(), prov_fx_[k].end(), 0.0);
     std::fill(prov_fy_[k].begin(), prov_fy_[k].end(), 0.0);
@@ -470,10 +483,9 @@ void Simulation::reduce_to_bodies() {
 }
 
 void Simulation::compute_forces() {
-  ensure_neighbor_list();
-  pair_forces();
-  wall_forces();
-  reduce_to_bodies();
+  ensure_neighbor_list(-1);
+  contact_forces();
+  provider_forces();
   forces_valid_ = true;
 }
 
@@ -485,36 +497,48 @@ void Simulation::step() {
   const double dt = params_.dt;
   const std::size_t nb = b_.x.size();
   const bool periodic = params_.periodic_x;
-  const double xlo = params_.x_lo, L = params_.x_hi - params_.x_lo;
+  const double xlo = params_.x_lo, xhi = params_.x_hi, L = params_.x_hi - params_.x_lo;
+  const bool newmark = params_.integrator == Integrator::newmark_explicit;
+  // The list's reference positions are only comparable if nothing was added/removed.
+  const bool check_moves = !structure_changed_ && nlist_.size() == d_.x.size();
   double* x = b_.x.data(); double* y = b_.y.data(); double* vx = b_.vx.data(); double* vy = b_.vy.data();
   double* th = b_.theta.data(); double* om = b_.omega.data();
   const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
   const double* m = b_.mass.data(); const double* I = b_.inertia.data();
-  if (params_.integrator == Integrator::newmark_explicit) {
-    // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-    for (std::size_t b = 0; b < nb; ++b) {
+  int moved = 0;
+  // One pass per body: integrate, wrap, place its discs and check them against the list's
+  // skin (instead of three separate passes over all bodies/discs).
+#pragma omp parallel for schedule(static) num_threads(params_.threads) reduction(| : moved)
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (newmark) {
+      // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
       const double ax = fx[b] / m[b], ay = fy[b] / m[b], al = tq[b] / I[b];
       x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
       th[b] += dt * om[b] + 0.5 * dt * dt * al;
       vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
-      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
-    }
-  } else {
-    // velocity Verlet, first half: kick by dt/2, drift by dt
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-    for (std::size_t b = 0; b < nb; ++b) {
+    } else {
+      // velocity Verlet, first half: kick by dt/2, drift by dt
       vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
       x[b] += dt * vx[b]; y[b] += dt * vy[b]; th[b] += dt * om[b];
-      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
+    }
+    if (periodic) {  // a body moves far less than L per step
+      x[b] = x[b] >= xhi ? x[b] - L : x[b];
+      x[b] = x[b] < xlo ? x[b] + L : x[b];
+    }
+    place_body(b);
+    if (check_moves) {
+      const int first = b_.first_disc[b], nd = b_.n_discs[b];
+      for (int k = first; k < first + nd; ++k) moved |= nlist_.moved(k, d_.x[k], d_.y[k]);
     }
   }
   for (auto& w : walls_) w.advance(dt);
   time_ += dt;
   ++step_;
-  update_disc_positions(0, nb);
-  compute_forces();
-  if (params_.integrator == Integrator::velocity_verlet) {
+  ensure_neighbor_list(check_moves ? moved : -1);
+  contact_forces();
+  provider_forces();
+  forces_valid_ = true;
+  if (!newmark) {
 #pragma omp parallel for schedule(static) num_threads(params_.threads)
     for (std::size_t b = 0; b < nb; ++b) {
       vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];

@@ -125,11 +125,14 @@ class Simulation {
   void load(std::istream& in);
 
  private:
+  void place_body(std::size_t b);
   void update_disc_positions(std::size_t b0, std::size_t b1);
-  void ensure_neighbor_list();
-  void pair_forces();
-  void wall_forces();
-  void reduce_to_bodies();
+  void ensure_neighbor_list(int moved);
+  void contact_forces();
+  void prepare_walls();
+  void wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
+  void reduce_body(std::size_t b);
+  void provider_forces();
   void update_thread_split();
 
   // Hot-loop copies of the per-disc data the pair kernel reads, packed so that one neighbour
