@@ -31,6 +31,7 @@ namespace {
 struct Result {
   std::size_t bodies = 0, discs = 0;
   double wall_s = 0, cpu_s = 0, sim_s = 0, dt = 0, rate = 0, contacts_per_disc = 0;
+  int builds = 0;
   long maxrss_kb = 0;
 };
 
@@ -99,7 +100,9 @@ Result run(const std::vector<std::string>& overrides, long settle, long steps, b
   const double c0 = cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   const double s0 = sim.time();
+  const int builds0 = sim.neighbor_list().builds();
   nip.advance_to(s0 + steps * dt);
+  r.builds = sim.neighbor_list().builds() - builds0;
   const auto t1 = std::chrono::steady_clock::now();
   r.cpu_s = cpu_seconds() - c0;
   r.wall_s = std::chrono::duration<double>(t1 - t0).count();
@@ -114,9 +117,9 @@ Result run(const std::vector<std::string>& overrides, long settle, long steps, b
 
 void print(const char* label, const Result& r, long steps) {
   std::printf("  %-28s particles=%zu discs=%zu wall=%.3f s cpu=%.3f s disc_steps_per_s=%.4g "
-              "wall_per_simulated_ms=%.2f s contacts_per_disc=%.3f peak_rss=%.1f MB\n",
+              "wall_per_simulated_ms=%.2f s contacts_per_disc=%.3f list_builds=%d peak_rss=%.1f MB\n",
               label, r.bodies, r.discs, r.wall_s, r.cpu_s, r.rate, r.wall_s / (r.sim_s * 1e3), r.contacts_per_disc,
-              r.maxrss_kb / 1024.0);
+              r.builds, r.maxrss_kb / 1024.0);
   (void)steps;
 }
 
