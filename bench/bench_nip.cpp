@@ -80,6 +80,9 @@ void report_table_error(const engine::Simulation& sim, const experiments::NipCon
 
 Result run(const std::vector<std::string>& overrides, long settle, long steps, bool print_params) {
   auto cfg = experiments::parse_nip_config(experiments::preset_text("black"), "preset:black", overrides);
+  // The magnet's per-particle loop runs on the engine's threads (MagnetConfig::threads is not
+  // a config key; the nip should set it from run.threads the same way).
+  cfg.magnet.threads = cfg.threads;
   experiments::NipRun nip(cfg);
   auto& sim = nip.sim();
   const double dt = nip.time_step().dt;

@@ -19,6 +19,8 @@ struct MagnetConfig {
   bool dipole_dipole = true;
   double dipole_cutoff = 42e-6;    // [m]: 8 R50 (docs/magnetic.md: ~1.3 % mean truncation error)
   int dipole_interval = 10;        // steps between dipole-dipole re-evaluations
+  int threads = 1;                 // OpenMP threads for the per-particle field force (set it to
+                                   // the engine's thread count; results do not depend on it)
 };
 
 // Magnet force on every toner body: moment m = 4/3 pi R^3 eta M(B) at the centre of mass
@@ -43,6 +45,7 @@ class MagnetForce final : public engine::BodyForce {
  private:
   void dipole_pass(const BodyStore& b);
   magnet::Sample field_at(Vec2 p);
+  const magnet::MagnetField* tile_for(Vec2 p);  // builds the tile if needed; null = use field_
   std::shared_ptr<const magnet::MagnetField> field_;
   // Tabulated field: tiles_[ty * kTilesX + tx] covers [x_lo + tx T, x_lo + (tx+1) T) x (same in y).
   static constexpr double kTileH = 20e-6;  // node spacing [m]
