@@ -161,28 +161,33 @@ void Simulation::add_force(std::shared_ptr<BodyForce> f) {
   forces_valid_ = false;
 }
 
-void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
-  for (std::size_t b = b0; b < b1; ++b) {
-    const int first = b_.first_disc[b], nd = b_.n_discs[b];
-    const double X = b_.x[b], Y = b_.y[b];
-    if (nd == 1 && d_.ox[first] == 0.0 && d_.oy[first] == 0.0) {
-      d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
-      continue;
-    }
-    const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
-    for (int k = first; k < first + nd; ++k) {
-      const double wx = c * d_.ox[k] - s * d_.oy[k];
-      const double wy = s * d_.ox[k] + c * d_.oy[k];
-      d_.wx[k] = wx; d_.wy[k] = wy;
-      d_.x[k] = X + wx; d_.y[k] = Y + wy;
-    }
+// World positions of the discs of body b from its pose.
+inline void Simulation::place_body(std::size_t b) {
+  const int first = b_.first_disc[b], nd = b_.n_discs[b];
+  const double X = b_.x[b], Y = b_.y[b];
+  if (nd == 1 && d_.ox[first] == 0.0 && d_.oy[first] == 0.0) {
+    d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
+    return;
+  }
+  const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
+  for (int k = first; k < first + nd; ++k) {
+    const double wx = c * d_.ox[k] - s * d_.oy[k];
+    const double wy = s * d_.ox[k] + c * d_.oy[k];
+    d_.wx[k] = wx; d_.wy[k] = wy;
+    d_.x[k] = X + wx; d_.y[k] = Y + wy;
   }
 }
 
-void Simulation::ensure_neighbor_list() {
+void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
+  for (std::size_t b = b0; b < b1; ++b) place_body(b);
+}
+
+// moved: -1 = unknown (check every disc), 0/1 = the caller already checked (step() does it
+// in the drift loop).
+void Simulation::ensure_neighbor_list(int moved) {
   if (structure_changed_) {
     nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
-  } else if (nlist_.needs_rebuild(d_.x, d_.y)) {
+  } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
     nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
   } else {
     return;
@@ -191,34 +196,66 @@ void Simulation::ensure_neighbor_list() {
   for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
 }
 
-template <bool kAdhesion>
-void Simulation::pair_rows(int i0, int i1, double* fx, double* fy, double* tq, double* fax, double* fay,
-                           std::int64_t& nc) {
-  const ContactParams& cp = params_.interactions[0].contact;
-  const models::HamakerParams& hp = params_.interactions[0].adhesion;
+// Row ranges per thread, balanced by list entries, and the highest disc index each range
+// writes to (rows hold j > i only, so a thread touches [split_[t], reach_hi_[t])). Recomputed
+// only when the list or the thread count changes.
+void Simulation::update_thread_split() {
+  const int nt = params_.threads;
+  const int n = static_cast<int>(d_.x.size());
+  if (split_builds_ == nlist_.builds() && split_threads_ == nt && static_cast<int>(nlist_.size()) == n) return;
+  split_builds_ = nlist_.builds();
+  split_threads_ = nt;
+  split_.assign(nt + 1, 0);
+  reach_hi_.assign(nt, 0);
+  const auto& rs = nlist_.row_start_;
+  const double per = static_cast<double>(nlist_.pair_count()) / nt;
+  for (int t = 1; t < nt; ++t) {
+    const int target = static_cast<int>(per * t);
+    int s = static_cast<int>(std::lower_bound(rs.begin(), rs.end(), target) - rs.begin());
+    split_[t] = std::clamp(s, split_[t - 1], n);
+  }
+  split_[nt] = n;
+  for (int t = 0; t < nt; ++t) {
+    int hi = split_[t + 1];
+    for (int i = split_[t]; i < split_[t + 1]; ++i)
+      if (rs[i + 1] > rs[i]) hi = std::max(hi, nlist_.nbr_[rs[i + 1] - 1] + 1);  // rows are sorted
+    reach_hi_[t] = hi;
+  }
+}
+
+// The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
+// list and its history), accumulates force and torque about the disc centre into f and the
+// adhesive part into fa (2 per disc). The contact law is models::normal_force and
+// models::tangential_force, inlined.
+template <bool kAdhesion, bool kPeriodic>
+void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out) {
+  const ContactParams cp = params_.interactions[0].contact;
+  const models::HamakerParams hp = params_.interactions[0].adhesion;
   const double dt = params_.dt;
-  const bool periodic = params_.periodic_x;
-  const double L = params_.x_hi - params_.x_lo;
+  const double L = params_.x_hi - params_.x_lo, hL = 0.5 * L;
   const double reach = pair_reach_;
-  const double* X = d_.x.data(); const double* Y = d_.y.data(); const double* R = d_.r.data();
-  const double* WX = d_.wx.data(); const double* WY = d_.wy.data();
-  const int* B = d_.body.data();
-  const double* VX = b_.vx.data(); const double* VY = b_.vy.data(); const double* W = b_.omega.data();
-  const double* M = b_.mass.data();
+  const bool mass_prop = cp.mass_proportional;
+  const PackedDisc* P = pdisc_.data();
+  const PackedVel* V = pvel_.data();
   const int* rs = nlist_.row_start_.data();
   const int* nb = nlist_.nbr_.data();
   double* eta = nlist_.eta_.data();
   std::uint8_t* sl = nlist_.slide_.data();
+  std::int64_t nc = 0;
   for (int i = i0; i < i1; ++i) {
-    const double xi = X[i], yi = Y[i], ri = R[i];
-    const int bi = B[i];
+    const PackedDisc pi = P[i];
+    const PackedVel vi = V[i];
     double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
     for (int e = rs[i]; e < rs[i + 1]; ++e) {
       const int j = nb[e];
-      double dx = xi - X[j];
-      const double dy = yi - Y[j];
-      if (periodic) dx -= L * std::nearbyint(dx / L);
-      const double rsum = ri + R[j];
+      const PackedDisc pj = P[j];
+      double dx = pi.x - pj.x;
+      const double dy = pi.y - pj.y;
+      if constexpr (kPeriodic) {  // minimum image; |dx| < 1.5 L since centres are wrapped
+        dx = dx > hL ? dx - L : dx;
+        dx = dx < -hL ? dx + L : dx;
+      }
+      const double rsum = pi.r + pj.r;
       const double d2 = dx * dx + dy * dy;
       const double rc = rsum + reach;
       if (d2 >= rc * rc) {
@@ -230,21 +267,16 @@ void Simulation::pair_rows(int i0, int i1, double* fx, double* fy, double* tq, d
       const double nx = dx * inv, ny = dy * inv;  // from j to i
       const double overlap = rsum - dist;
       double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
-      double fa = 0.0;
-      if constexpr (kAdhesion) fa = models::hamaker_force(hp, ri, R[j], -overlap);
       if (overlap > 0.0) {
         ++nc;
-        const int bj = B[j];
-        const double li = ri - 0.5 * overlap, lj = R[j] - 0.5 * overlap;
-        // lever arms from the body centres of mass to the contact point
-        const double rix = WX[i] - li * nx, riy = WY[i] - li * ny;
-        const double rjx = WX[j] + lj * nx, rjy = WY[j] + lj * ny;
-        const double vrx = (VX[bi] - W[bi] * riy) - (VX[bj] - W[bj] * rjy);
-        const double vry = (VY[bi] + W[bi] * rix) - (VY[bj] + W[bj] * rjx);
+        const PackedVel vj = V[j];
+        const double li = pi.r - 0.5 * overlap, lj = pj.r - 0.5 * overlap;  // centre to contact point
+        // relative velocity of the contact points: v_c + w x (lever), lever -li n on i, +lj n on j
+        const double vrx = (vi.vx + vi.w * li * ny) - (vj.vx - vj.w * lj * ny);
+        const double vry = (vi.vy - vi.w * li * nx) - (vj.vy + vj.w * lj * nx);
         const double vn = vrx * nx + vry * ny;
         const double vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
-        const double mi = M[bi], mj = M[bj];
-        const double mred = mi * mj / (mi + mj);
+        const double mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
         const double fn = models::normal_force(cp, overlap, vn, mred);
         TangentialState st{eta[e], sl[e] != 0};
         const double ft = models::tangential_force(cp, st, vt, fn, dt, mred);
@@ -257,155 +289,188 @@ void Simulation::pair_rows(int i0, int i1, double* fx, double* fy, double* tq, d
         eta[e] = 0.0; sl[e] = 0;
       }
       if constexpr (kAdhesion) {
-        fnx -= fa * nx; fny -= fa * ny;
-        faxi -= fa * nx; fayi -= fa * ny;
-        fax[j] += fa * nx; fay[j] += fa * ny;
+        const double fad = models::hamaker_force(hp, pi.r, pj.r, -overlap);
+        fnx -= fad * nx; fny -= fad * ny;
+        faxi -= fad * nx; fayi -= fad * ny;
+        fa[2 * j] += fad * nx; fa[2 * j + 1] += fad * ny;
       }
       fxi += fnx; fyi += fny; tqi += ti;
-      fx[j] -= fnx; fy[j] -= fny; tq[j] += tj;
+      f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += tj;
     }
-    fx[i] += fxi; fy[i] += fyi; tq[i] += tqi;
-    if constexpr (kAdhesion) { fax[i] += faxi; fay[i] += fayi; }
+    f[i].fx += fxi; f[i].fy += fyi; f[i].tq += tqi;
+    if constexpr (kAdhesion) { fa[2 * i] += faxi; fa[2 * i + 1] += fayi; }
   }
+  nc_out = nc;
 }
 
-void Simulation::pair_forces() {
-  const std::size_t n = d_.x.size();
+// Pair forces, wall forces and their sum per body, in one parallel region: pack the discs,
+// run the pair kernel on each thread's rows, reduce the thread buffers per disc and add the
+// wall forces of that disc, then sum per body.
+void Simulation::contact_forces() {
+  const int n = static_cast<int>(d_.x.size());
+  const int nb = static_cast<int>(b_.x.size());
+  const bool has_walls = !walls_.empty();
+  if (has_walls) prepare_walls();
   const int nt = params_.threads;
   const bool adh = params_.interactions[0].adhesion.hamaker_J != 0.0;
-  if (static_cast<int>(tbuf_.size()) != nt) tbuf_.assign(nt, {});
-  std::int64_t total_nc = 0;
-  if (nt == 1) {
-    std::fill(d_.fx.begin(), d_.fx.end(), 0.0); std::fill(d_.fy.begin(), d_.fy.end(), 0.0);
-    std::fill(d_.tq.begin(), d_.tq.end(), 0.0);
-    std::fill(d_.fax.begin(), d_.fax.end(), 0.0); std::fill(d_.fay.begin(), d_.fay.end(), 0.0);
-    if (adh) pair_rows<true>(0, static_cast<int>(n), d_.fx.data(), d_.fy.data(), d_.tq.data(), d_.fax.data(), d_.fay.data(), total_nc);
-    else pair_rows<false>(0, static_cast<int>(n), d_.fx.data(), d_.fy.data(), d_.tq.data(), d_.fax.data(), d_.fay.data(), total_nc);
-    n_contacts_ = total_nc;
-    return;
-  }
-  // Split rows so each thread gets about the same number of list entries.
-  std::vector<int> split(nt + 1, 0);
-  const auto& rs = nlist_.row_start_;
-  const double per = static_cast<double>(nlist_.pair_count()) / nt;
-  for (int t = 1; t < nt; ++t) {
-    const int target = static_cast<int>(per * t);
-    split[t] = static_cast<int>(std::lower_bound(rs.begin(), rs.end(), target) - rs.begin());
-    split[t] = std::clamp(split[t], split[t - 1], static_cast<int>(n));
-  }
-  split[nt] = static_cast<int>(n);
-  std::vector<std::int64_t> ncs(nt, 0);
+  const bool periodic = params_.periodic_x;
+  update_thread_split();
+  pdisc_.resize(n);
+  pvel_.resize(n);
+  if (static_cast<int>(tforce_.size()) != nt) tforce_.assign(nt, {});
+  if (static_cast<int>(tadh_.size()) != nt) tadh_.assign(nt, {});
+  thread_nc_.assign(nt, 0);
 #pragma omp parallel num_threads(nt)
   {
     const int t = omp_get_thread_num();
-    auto& buf = tbuf_[t];
-    buf.assign(5 * n, 0.0);
-    double* fx = buf.data(); double* fy = fx + n; double* tq = fy + n; double* fax = tq + n; double* fay = fax + n;
-    if (adh) pair_rows<true>(split[t], split[t + 1], fx, fy, tq, fax, fay, ncs[t]);
-    else pair_rows<false>(split[t], split[t + 1], fx, fy, tq, fax, fay, ncs[t]);
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      const int b = d_.body[i];
+      const double w = b_.omega[b];
+      pdisc_[i] = {d_.x[i], d_.y[i], d_.r[i], b_.mass[b]};
+      pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
+    }
+    // (implicit barrier: every thread reads all packed discs)
+    auto& buf = tforce_[t];
+    if (static_cast<int>(buf.size()) < n) buf.resize(n);
+    const int lo = split_[t], hi = reach_hi_[t];
+    std::fill(buf.begin() + lo, buf.begin() + hi, PackedForce{0.0, 0.0, 0.0, 0.0});
+    double* fa = nullptr;
+    if (adh) {
+      auto& ab = tadh_[t];
+      if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
+      std::fill(ab.begin() + 2 * lo, ab.begin() + 2 * hi, 0.0);
+      fa = ab.data();
+    }
+    std::int64_t nc = 0;
+    if (adh) {
+      if (periodic) pair_rows<true, true>(lo, split_[t + 1], buf.data(), fa, nc);
+      else pair_rows<true, false>(lo, split_[t + 1], buf.data(), fa, nc);
+    } else {
+      if (periodic) pair_rows<false, true>(lo, split_[t + 1], buf.data(), fa, nc);
+      else pair_rows<false, false>(lo, split_[t + 1], buf.data(), fa, nc);
+    }
+    thread_nc_[t] = nc;
+    std::int64_t wall_nc = 0;
 #pragma omp barrier
-    // Reduce in fixed thread order, each thread over its own slice of discs.
-    const std::size_t lo = n * t / nt, hi = n * (t + 1) / nt;
-    for (std::size_t i = lo; i < hi; ++i) {
+    // Reduce in fixed thread order (bitwise reproducible for a given thread count), each
+    // thread over its own slice of discs, adding only the buffers whose window covers it.
+#pragma omp for schedule(static)
+    for (int i = 0; i < n; ++i) {
       double a = 0, b = 0, c = 0, p = 0, q = 0;
       for (int u = 0; u < nt; ++u) {
-        const double* bu = tbuf_[u].data();
-        a += bu[i]; b += bu[n + i]; c += bu[2 * n + i]; p += bu[3 * n + i]; q += bu[4 * n + i];
+        if (i < split_[u] || i >= reach_hi_[u]) continue;
+        const PackedForce& g = tforce_[u][i];
+        a += g.fx; b += g.fy; c += g.tq;
+        if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
+      if (has_walls) wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
     }
-  }
-  for (auto c : ncs) total_nc += c;
-  n_contacts_ = total_nc;
-}
-
-void Simulation::wall_forces() {
-  if (walls_.empty()) return;
-  const std::size_t n = d_.x.size();
-  const double dt = params_.dt;
-  std::int64_t nc_total = 0;
-#pragma omp parallel num_threads(params_.threads) reduction(+ : nc_total)
-  {
-    std::vector<geometry::WallHit> hits;
-    hits.reserve(16);
-    std::int64_t new_key[kWallSlots];
-    double new_eta[kWallSlots];
-    std::uint8_t new_sl[kWallSlots];
+    thread_nc_[t] += wall_nc;
+    // (implicit barrier: a body's discs may lie in another thread's slice)
 #pragma omp for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 c{d_.x[i], d_.y[i]};
-      const double r = d_.r[i];
-      const int bi = d_.body[i];
-      int nnew = 0;
-      double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
-      for (std::size_t w = 0; w < walls_.size(); ++w) {
-        const auto& wall = walls_[w];
-        const Interaction& ia = params_.interactions[wall.interaction];
-        const double reach = ia.adhesion.hamaker_J != 0.0 ? ia.adhesion.cutoff_m : 0.0;
-        hits.clear();
-        wall.query(c, r, reach, hits);
-        for (const auto& h : hits) {
-          double fnx = 0, fny = 0;
-          const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
-          if (h.gap < 0.0) {
-            ++nc_total;
-            const double overlap = -h.gap;
-            const double l = r - 0.5 * overlap;
-            const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
-            const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
-            const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
-            const double vn = vrx * h.normal.x + vry * h.normal.y;
-            const double vt = -vrx * h.normal.y + vry * h.normal.x;
-            const double m = b_.mass[bi];
-            const double fn = models::normal_force(ia.contact, overlap, vn, m);
-            const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
-            TangentialState st{};
-            for (int q = 0; q < kWallSlots; ++q) {
-              if (d_.wall_key[i * kWallSlots + q] == key) {
-                st.eta = d_.wall_eta[i * kWallSlots + q];
-                st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
-                break;
-              }
-            }
-            const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
-            if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
-              new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
-            }
-            fnx = fn * h.normal.x - ft * h.normal.y;
-            fny = fn * h.normal.y + ft * h.normal.x;
-            tq += -l * ft;
-          }
-          fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
-          fax -= fa * h.normal.x; fay -= fa * h.normal.y;
-          fx += fnx; fy += fny;
-        }
-      }
-      for (int q = 0; q < kWallSlots; ++q) {
-        d_.wall_key[i * kWallSlots + q] = q < nnew ? new_key[q] : -1;
-        d_.wall_eta[i * kWallSlots + q] = q < nnew ? new_eta[q] : 0.0;
-        d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
-      }
-      d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay;
-    }
+    for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
   }
-  n_contacts_ += nc_total;
+  std::int64_t total = 0;
+  for (auto c : thread_nc_) total += c;
+  n_contacts_ = total;
 }
 
-void Simulation::reduce_to_bodies() {
-  const std::size_t nb = b_.x.size();
-  const Vec2 g = params_.gravity;
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-  for (std::size_t b = 0; b < nb; ++b) {
-    const int first = b_.first_disc[b], nd = b_.n_discs[b];
-    double fx = 0, fy = 0, tq = 0;
-    for (int k = first; k < first + nd; ++k) {
-      fx += d_.fx[k]; fy += d_.fy[k];
-      tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
-    }
-    b_.fx[b] = fx + b_.mass[b] * g.x;
-    b_.fy[b] = fy + b_.mass[b] * g.y;
-    b_.torque[b] = tq;
+void Simulation::prepare_walls() {
+  const std::size_t nw = walls_.size();
+  wall_reach_.resize(nw);
+  for (std::size_t w = 0; w < nw; ++w) {
+    const auto& ad = params_.interactions[walls_[w].interaction].adhesion;
+    wall_reach_[w] = ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0;
   }
+  if (static_cast<int>(thread_hits_.size()) < params_.threads) thread_hits_.resize(params_.threads);
+}
+
+// Wall forces on disc i, added to its force arrays; wall history slots updated.
+void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc) {
+  const std::size_t nw = walls_.size();
+  const double dt = params_.dt;
+  std::int64_t new_key[kWallSlots];
+  double new_eta[kWallSlots];
+  std::uint8_t new_sl[kWallSlots];
+  const Vec2 c{d_.x[i], d_.y[i]};
+  const double r = d_.r[i];
+  int nnew = 0;
+  double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
+  bool touched = false;
+  for (std::size_t w = 0; w < nw; ++w) {
+    const auto& wall = walls_[w];
+    if (!wall.may_touch(c, r, wall_reach_[w])) continue;  // most discs: no trigonometry, no query
+    const Interaction& ia = params_.interactions[wall.interaction];
+    hits.clear();
+    wall.query(c, r, wall_reach_[w], hits);
+    const int bi = d_.body[i];
+    for (const auto& h : hits) {
+      touched = true;
+      double fnx = 0, fny = 0;
+      const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
+      if (h.gap < 0.0) {
+        ++nc;
+        const double overlap = -h.gap;
+        const double l = r - 0.5 * overlap;
+        const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
+        const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
+        const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
+        const double vn = vrx * h.normal.x + vry * h.normal.y;
+        const double vt = -vrx * h.normal.y + vry * h.normal.x;
+        const double m = b_.mass[bi];
+        const double fn = models::normal_force(ia.contact, overlap, vn, m);
+        const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+        TangentialState st{};
+        for (int q = 0; q < kWallSlots; ++q) {
+          if (d_.wall_key[i * kWallSlots + q] == key) {
+            st.eta = d_.wall_eta[i * kWallSlots + q];
+            st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
+            break;
+          }
+        }
+        const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
+        if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
+          new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
+        }
+        fnx = fn * h.normal.x - ft * h.normal.y;
+        fny = fn * h.normal.y + ft * h.normal.x;
+        tq += -l * ft;
+      }
+      fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
+      fax -= fa * h.normal.x; fay -= fa * h.normal.y;
+      fx += fnx; fy += fny;
+    }
+  }
+  // Slots are filled from 0, so an empty slot 0 means nothing to clear.
+  if (nnew > 0 || d_.wall_key[i * kWallSlots] != -1) {
+    for (int q = 0; q < kWallSlots; ++q) {
+      d_.wall_key[i * kWallSlots + q] = q < nnew ? new_key[q] : -1;
+      d_.wall_eta[i * kWallSlots + q] = q < nnew ? new_eta[q] : 0.0;
+      d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
+    }
+  }
+  if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay; }
+}
+
+// Total force and torque about the centre of mass of body b from its discs, plus gravity.
+inline void Simulation::reduce_body(std::size_t b) {
+  const Vec2 g = params_.gravity;
+  const int first = b_.first_disc[b], nd = b_.n_discs[b];
+  double fx = 0, fy = 0, tq = 0;
+  for (int k = first; k < first + nd; ++k) {
+    fx += d_.fx[k]; fy += d_.fy[k];
+    tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
+  }
+  b_.fx[b] = fx + b_.mass[b] * g.x;
+  b_.fy[b] = fy + b_.mass[b] * g.y;
+  b_.torque[b] = tq;
+}
+
+// The body forces of the external providers (serial: their code is not ours).
+void Simulation::provider_forces() {
+  const std::size_t nb = b_.x.size();
   for (std::size_t k = 0; k < forces_.size(); ++k) {
     std::fill(prov_fx_[k].begin(), prov_fx_[k].end(), 0.0);
     std::fill(prov_fy_[k].begin(), prov_fy_[k].end(), 0.0);
@@ -418,10 +483,9 @@ void Simulation::reduce_to_bodies() {
 }
 
 void Simulation::compute_forces() {
-  ensure_neighbor_list();
-  pair_forces();
-  wall_forces();
-  reduce_to_bodies();
+  ensure_neighbor_list(-1);
+  contact_forces();
+  provider_forces();
   forces_valid_ = true;
 }
 
@@ -433,36 +497,48 @@ void Simulation::step() {
   const double dt = params_.dt;
   const std::size_t nb = b_.x.size();
   const bool periodic = params_.periodic_x;
-  const double xlo = params_.x_lo, L = params_.x_hi - params_.x_lo;
+  const double xlo = params_.x_lo, xhi = params_.x_hi, L = params_.x_hi - params_.x_lo;
+  const bool newmark = params_.integrator == Integrator::newmark_explicit;
+  // The list's reference positions are only comparable if nothing was added/removed.
+  const bool check_moves = !structure_changed_ && nlist_.size() == d_.x.size();
   double* x = b_.x.data(); double* y = b_.y.data(); double* vx = b_.vx.data(); double* vy = b_.vy.data();
   double* th = b_.theta.data(); double* om = b_.omega.data();
   const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
   const double* m = b_.mass.data(); const double* I = b_.inertia.data();
-  if (params_.integrator == Integrator::newmark_explicit) {
-    // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-    for (std::size_t b = 0; b < nb; ++b) {
+  int moved = 0;
+  // One pass per body: integrate, wrap, place its discs and check them against the list's
+  // skin (instead of three separate passes over all bodies/discs).
+#pragma omp parallel for schedule(static) num_threads(params_.threads) reduction(| : moved)
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (newmark) {
+      // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
       const double ax = fx[b] / m[b], ay = fy[b] / m[b], al = tq[b] / I[b];
       x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
       th[b] += dt * om[b] + 0.5 * dt * dt * al;
       vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
-      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
-    }
-  } else {
-    // velocity Verlet, first half: kick by dt/2, drift by dt
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
-    for (std::size_t b = 0; b < nb; ++b) {
+    } else {
+      // velocity Verlet, first half: kick by dt/2, drift by dt
       vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
       x[b] += dt * vx[b]; y[b] += dt * vy[b]; th[b] += dt * om[b];
-      if (periodic) x[b] -= L * std::floor((x[b] - xlo) / L);
+    }
+    if (periodic) {  // a body moves far less than L per step
+      x[b] = x[b] >= xhi ? x[b] - L : x[b];
+      x[b] = x[b] < xlo ? x[b] + L : x[b];
+    }
+    place_body(b);
+    if (check_moves) {
+      const int first = b_.first_disc[b], nd = b_.n_discs[b];
+      for (int k = first; k < first + nd; ++k) moved |= nlist_.moved(k, d_.x[k], d_.y[k]);
     }
   }
   for (auto& w : walls_) w.advance(dt);
   time_ += dt;
   ++step_;
-  update_disc_positions(0, nb);
-  compute_forces();
-  if (params_.integrator == Integrator::velocity_verlet) {
+  ensure_neighbor_list(check_moves ? moved : -1);
+  contact_forces();
+  provider_forces();
+  forces_valid_ = true;
+  if (!newmark) {
 #pragma omp parallel for schedule(static) num_threads(params_.threads)
     for (std::size_t b = 0; b < nb; ++b) {
       vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];

@@ -129,13 +129,24 @@ class Simulation {
   void load(std::istream& in);
 
  private:
+  void place_body(std::size_t b);
   void update_disc_positions(std::size_t b0, std::size_t b1);
-  void ensure_neighbor_list();
-  void pair_forces();
-  void wall_forces();
-  void reduce_to_bodies();
-  template <bool kAdhesion>
-  void pair_rows(int i0, int i1, double* fx, double* fy, double* tq, double* fax, double* fay, std::int64_t& nc);
+  void ensure_neighbor_list(int moved);
+  void contact_forces();
+  void prepare_walls();
+  void wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
+  void reduce_body(std::size_t b);
+  void provider_forces();
+  void update_thread_split();
+
+  // Hot-loop copies of the per-disc data the pair kernel reads, packed so that one neighbour
+  // costs two cache lines to read and one to write instead of ~12 scattered SoA loads
+  // (docs/performance.md). Rebuilt from the SoA stores at every force evaluation.
+  struct alignas(32) PackedDisc { double x, y, r, m; };      // centre [m], radius [m], body mass [kg]
+  struct alignas(32) PackedVel { double vx, vy, w, pad; };   // disc-centre velocity [m/s], body spin [rad/s]
+  struct alignas(32) PackedForce { double fx, fy, tq, pad; };
+  template <bool kAdhesion, bool kPeriodic>
+  void pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc);
 
   EngineParams params_;
   std::vector<geometry::Wall> walls_;
@@ -148,7 +159,17 @@ class Simulation {
   bool forces_valid_ = false;
   std::vector<std::shared_ptr<BodyForce>> forces_;
   std::vector<std::vector<double>> prov_fx_, prov_fy_, prov_tq_;
-  std::vector<std::vector<double>> tbuf_;  // per-thread force buffers (5 arrays each)
+  std::vector<PackedDisc> pdisc_;
+  std::vector<PackedVel> pvel_;
+  std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers
+  std::vector<std::vector<double>> tadh_;         // per-thread adhesive part (fax, fay interleaved)
+  // Thread t owns list rows [split_[t], split_[t+1]) and writes discs [split_[t], reach_hi_[t]):
+  // only that window of its buffer is zeroed and reduced.
+  std::vector<int> split_, reach_hi_;
+  std::vector<std::int64_t> thread_nc_;
+  int split_builds_ = -1, split_threads_ = 0;
+  std::vector<std::vector<geometry::WallHit>> thread_hits_;  // per-thread wall query scratch
+  std::vector<double> wall_reach_;                          // adhesion reach of each wall [m]
   double time_ = 0.0;
   std::int64_t step_ = 0;
   std::int64_t next_id_ = 0;

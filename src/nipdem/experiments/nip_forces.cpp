@@ -21,19 +21,80 @@ std::shared_ptr<const magnet::MagnetField> make_magnet_field(const MagnetConfig&
 }
 
 MagnetForce::MagnetForce(std::shared_ptr<const magnet::MagnetField> field, MagnetConfig cfg)
-    : field_(std::move(field)), cfg_(std::move(cfg)) {}
+    : field_(std::move(field)), cfg_(std::move(cfg)) {
+  // A map is already a table; anything else (the analytic knife/pole) is tabulated in tiles.
+  tabulate_ = field_ && dynamic_cast<const io::FieldMap*>(field_.get()) == nullptr;
+  if (tabulate_) tiles_.resize(static_cast<std::size_t>(kTilesX) * kTilesY);
+}
+
+// Field at p: from the tile containing p (built on first use), or from the source itself
+// outside the tiled region (|x| > 12.8 mm or |y| > 6.4 mm) or for a field map.
+magnet::Sample MagnetForce::field_at(Vec2 p) {
+  const magnet::MagnetField* t = tile_for(p);
+  return t ? t->at(p) : field_->at(p);
+}
+
+const magnet::MagnetField* MagnetForce::tile_for(Vec2 p) {
+  if (!tabulate_) return nullptr;
+  constexpr double T = kTileH * kTileCells;
+  const double fx = std::floor(p.x / T) + kTilesX / 2, fy = std::floor(p.y / T) + kTilesY / 2;
+  if (!(fx >= 0.0 && fx < kTilesX && fy >= 0.0 && fy < kTilesY)) return nullptr;  // also NaN
+  const int tx = static_cast<int>(fx), ty = static_cast<int>(fy);
+  auto& tile = tiles_[static_cast<std::size_t>(ty) * kTilesX + tx];
+  if (!tile) {
+    // Nodes at integer multiples of h, two beyond the tile on each side so every node used
+    // inside the tile has central 4th-order derivatives: the tile's values depend only on
+    // (tx, ty), not on which tiles exist.
+    const int n = kTileCells + 1 + 4;
+    const long gx0 = static_cast<long>(tx - kTilesX / 2) * kTileCells - 2;
+    const long gy0 = static_cast<long>(ty - kTilesY / 2) * kTileCells - 2;
+    std::vector<double> bx, by;
+    bx.reserve(static_cast<std::size_t>(n) * n);
+    by.reserve(static_cast<std::size_t>(n) * n);
+    bool finite = true;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const magnet::Sample s = field_->at({static_cast<double>(gx0 + i) * kTileH, static_cast<double>(gy0 + j) * kTileH});
+        bx.push_back(s.B.x);
+        by.push_back(s.B.y);
+        finite = finite && std::isfinite(s.B.x) && std::isfinite(s.B.y);
+      }
+    // A node on a magnet corner (log singularity, inside the roller): keep the exact source there.
+    if (!finite) tile = field_;
+    else tile = std::make_shared<io::FieldMap>(static_cast<double>(gx0) * kTileH, static_cast<double>(gy0) * kTileH, kTileH,
+                                          kTileH, n, n, std::move(bx), std::move(by), "tile of " + field_->describe());
+  }
+  return tile.get();
+}
 
 void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<double> fx, std::span<double> fy,
                       std::span<double>) {
   const std::size_t n = b.x.size();
   moment_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double R = 0.5 * b.size[i];
-    const magnet::Sample s = field_->at({b.x[i], b.y[i]});
-    moment_[i] = magnet::induced_moment(cfg_.toner, R, s.B);  // eq. 4.5.1
-    const Vec2 f = magnet::dipole_force(moment_[i], s);         // eq. 2.4.34: (m . grad) B
-    fx[i] += f.x;
-    fy[i] += f.y;
+  const int nt = std::max(1, cfg_.threads);
+  if (nt == 1) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const double R = 0.5 * b.size[i];
+      const magnet::Sample s = field_at({b.x[i], b.y[i]});
+      moment_[i] = magnet::induced_moment(cfg_.toner, R, s.B);  // eq. 4.5.1
+      const Vec2 f = magnet::dipole_force(moment_[i], s);         // eq. 2.4.34: (m . grad) B
+      fx[i] += f.x;
+      fy[i] += f.y;
+    }
+  } else {
+    // Tiles are built serially first; the parallel loop only reads them. Each particle is
+    // independent, so the result does not depend on the thread count.
+    for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
+#pragma omp parallel for schedule(static) num_threads(nt)
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2 p{b.x[i], b.y[i]};
+      const magnet::MagnetField* t = tile_for(p);  // exists now: no write
+      const magnet::Sample s = t ? t->at(p) : field_->at(p);
+      moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
+      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
+      fx[i] += f.x;
+      fy[i] += f.y;
+    }
   }
   if (!cfg_.dipole_dipole) return;
   // Re-evaluate the pair forces every dipole_interval calls, or when bodies changed.

@@ -8,15 +8,31 @@ namespace nipdem::geometry {
 
 bool NeighborList::needs_rebuild(std::span<const double> x, std::span<const double> y) const {
   if (x.size() != x0_.size()) return true;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    double dx = x[i] - x0_[i], dy = y[i] - y0_[i];
-    if (params_.periodic_x) {
-      const double L = params_.x_hi - params_.x_lo;
-      dx -= L * std::nearbyint(dx / L);
+  // Called every step: no libm call (nearbyint is not inlined without SSE4.1) and no early
+  // exit inside the loop, so it vectorises; a moved disc is rare.
+  const std::size_t n = x.size();
+  const double* px = x.data(); const double* py = y.data();
+  const double* qx = x0_.data(); const double* qy = y0_.data();
+  const double L = params_.x_hi - params_.x_lo, hL = 0.5 * L;
+  const bool periodic = params_.periodic_x;
+  const double lim = half_skin2_;
+  bool moved = false;
+  constexpr std::size_t kBlock = 256;
+  for (std::size_t b0 = 0; b0 < n && !moved; b0 += kBlock) {
+    const std::size_t b1 = std::min(n, b0 + kBlock);
+    int any = 0;
+    for (std::size_t i = b0; i < b1; ++i) {
+      double dx = px[i] - qx[i];
+      const double dy = py[i] - qy[i];
+      if (periodic) {  // a disc that crossed the periodic boundary moved by about +-L
+        dx = dx > hL ? dx - L : dx;
+        dx = dx < -hL ? dx + L : dx;
+      }
+      any |= (dx * dx + dy * dy > lim);
     }
-    if (dx * dx + dy * dy > half_skin2_) return true;
+    moved = any != 0;
   }
-  return false;
+  return moved;
 }
 
 void NeighborList::rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,

@@ -28,6 +28,19 @@ class NeighborList {
   // True if some disc moved more than skin/2 since the last build (then rebuild()).
   bool needs_rebuild(std::span<const double> x, std::span<const double> y) const;
 
+  // Per-disc form of needs_rebuild() for fused loops: true if disc i, now at (x, y), moved
+  // more than skin/2 since the last build. Requires size() == number of discs.
+  bool moved(std::size_t i, double x, double y) const {
+    double dx = x - x0_[i];
+    const double dy = y - y0_[i];
+    if (params_.periodic_x) {  // a disc that crossed the periodic boundary moved by about +-L
+      const double L = params_.x_hi - params_.x_lo;
+      dx = dx > 0.5 * L ? dx - L : dx;
+      dx = dx < -0.5 * L ? dx + L : dx;
+    }
+    return dx * dx + dy * dy > half_skin2_;
+  }
+
   std::size_t size() const { return row_start_.empty() ? 0 : row_start_.size() - 1; }
   std::size_t pair_count() const { return nbr_.size(); }
   int builds() const { return builds_; }

@@ -1,6 +1,7 @@
 #include "nipdem/geometry/walls.hpp"
 
 #include <cmath>
+#include <vector>
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
@@ -56,12 +57,16 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   if (s < 0) s += circumference;
   const int k0 = static_cast<int>(std::floor(s / P));
   const int m = static_cast<int>(profile.size()) - 1;  // segments per period
+  // World positions of one period's profile vertices, computed once per period and shared
+  // by its segments and vertices (each costs a sin and a cos). Scratch grows once per thread.
+  thread_local std::vector<Vec2> pts;
+  if (pts.size() < profile.size()) pts.resize(profile.size());
   for (int dk = -1; dk <= 1; ++dk) {
     const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
-    // wrap so the profile points are evaluated near the disc (avoid 2 pi jumps)
+    for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
     for (int j = 0; j < m; ++j) {
-      const Vec2 a = profile_point(k, profile[j]);
-      const Vec2 b = profile_point(k, profile[j + 1]);
+      const Vec2 a = pts[j];
+      const Vec2 b = pts[j + 1];
       double t;
       const Vec2 q = closest_on_segment(a, b, c, t);
       // Interior contacts only; convex vertices are handled below, concave vertices are
@@ -79,7 +84,7 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - P, profile[m - 1].y} : profile[j - 1];
       const Vec2 cur = profile[j], next = profile[j + 1];
       if (cross(cur - prev, next - cur) <= 0.0) continue;  // concave or straight
-      const Vec2 v = profile_point(k, cur);
+      const Vec2 v = pts[j];
       const Vec2 dq = c - v;
       const double dd = norm(dq);
       const double gap = dd - r;

@@ -53,6 +53,19 @@ struct Wall {
   bool rough() const { return !profile.empty(); }
   // Appends all features within `reach` of a disc (centre c, radius r) to hits.
   void query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const;
+  // Cheap conservative pre-test (inline, no trigonometry): false only if query() would find
+  // nothing. The engine calls it for every disc and wall each step, query() only if true.
+  bool may_touch(Vec2 c, double r, double reach) const {
+    constexpr double kSlack = 1e-9;  // relative margin: never reject what query() accepts
+    if (kind == Kind::plane) return dot(c - point, normal) - r <= reach + kSlack * r;
+    const double d2 = norm2(c - centre);
+    if (inside) {
+      const double a = radius - r - reach;  // query finds nothing while |c - centre| < a
+      return a <= 0.0 || d2 >= a * a * (1.0 - kSlack);
+    }
+    const double a = radius + r + reach;  // features lie at depth >= 0 inside the base circle
+    return d2 <= a * a * (1.0 + kSlack);
+  }
   // Advances the prescribed motion by dt.
   void advance(double dt) { angle += omega * dt; }
   // World position of profile point (s, depth) in period k, at the current angle.
