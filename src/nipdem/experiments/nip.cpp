@@ -49,6 +49,7 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   if (cfg_.roughness && cfg_.rough_height > 0.0) geometry::set_pyramid_roughness(roller, cfg_.rough_height, cfg_.rough_base, cfg_.rough_spacing);
   geometry::Wall drum = cylinder("di_drum", drum_centre(), cfg_.drum_radius, cfg_.drum_speed, 2);
   sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
+  cfg_.magnet.threads = cfg_.threads;
   if (auto field = make_magnet_field(cfg_.magnet)) sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
   if (cfg_.electric.enabled) {
     electric_ = std::make_shared<ElectricForce>(sim_.get(), cfg_.electric);

@@ -136,6 +136,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     c.magnet.dipole_dipole = s.boolean("dipole_dipole", c.magnet.dipole_dipole);
     c.magnet.dipole_cutoff = s.number("dipole_cutoff_m", 1e-7, 1e-3, c.magnet.dipole_cutoff);
     c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000, c.magnet.dipole_interval));
+    c.magnet.field_interval = static_cast<int>(s.integer("field_interval_steps", 1, 100000, c.magnet.field_interval));
     s.finish();
     if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
   }

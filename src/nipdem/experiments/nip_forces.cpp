@@ -70,42 +70,47 @@ const magnet::MagnetField* MagnetForce::tile_for(Vec2 p) {
 void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<double> fx, std::span<double> fy,
                       std::span<double>) {
   const std::size_t n = b.x.size();
+  // Held forces belong to bodies by id; any change of the body set forces a fresh evaluation.
+  bool same = ids_.size() == n;
+  if (same) for (std::size_t i = 0; i < n && same; ++i) same = ids_[i] == b.id[i];
+  if (!same || calls_ % cfg_.field_interval == 0) field_pass(b);
+  if (cfg_.dipole_dipole && (!same || calls_ % cfg_.dipole_interval == 0)) dipole_pass(b);
+  if (!same) ids_.assign(b.id.begin(), b.id.end());
+  ++calls_;
+  for (std::size_t i = 0; i < n; ++i) { fx[i] += ffx_[i]; fy[i] += ffy_[i]; }
+  if (cfg_.dipole_dipole)
+    for (std::size_t i = 0; i < n; ++i) { fx[i] += dfx_[i]; fy[i] += dfy_[i]; }
+}
+
+void MagnetForce::field_pass(const BodyStore& b) {
+  const std::size_t n = b.x.size();
   moment_.resize(n);
+  ffx_.assign(n, 0.0);
+  ffy_.assign(n, 0.0);
   const int nt = std::max(1, cfg_.threads);
   if (nt == 1) {
     for (std::size_t i = 0; i < n; ++i) {
-      const double R = 0.5 * b.size[i];
       const magnet::Sample s = field_at({b.x[i], b.y[i]});
-      moment_[i] = magnet::induced_moment(cfg_.toner, R, s.B);  // eq. 4.5.1
-      const Vec2 f = magnet::dipole_force(moment_[i], s);         // eq. 2.4.34: (m . grad) B
-      fx[i] += f.x;
-      fy[i] += f.y;
-    }
-  } else {
-    // Tiles are built serially first; the parallel loop only reads them. Each particle is
-    // independent, so the result does not depend on the thread count.
-    for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 p{b.x[i], b.y[i]};
-      const magnet::MagnetField* t = tile_for(p);  // exists now: no write
-      const magnet::Sample s = t ? t->at(p) : field_->at(p);
       moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
-      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
-      fx[i] += f.x;
-      fy[i] += f.y;
+      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34: (m . grad) B
+      ffx_[i] = f.x;
+      ffy_[i] = f.y;
     }
+    return;
   }
-  if (!cfg_.dipole_dipole) return;
-  // Re-evaluate the pair forces every dipole_interval calls, or when bodies changed.
-  bool same = dipole_ids_.size() == n;
-  if (same) for (std::size_t i = 0; i < n && same; ++i) same = dipole_ids_[i] == b.id[i];
-  if (!same || calls_ % cfg_.dipole_interval == 0) {
-    dipole_pass(b);
-    dipole_ids_.assign(b.id.begin(), b.id.end());
+  // Tiles are built serially first; the parallel loop only reads them. Each particle is
+  // independent, so the result does not depend on the thread count.
+  for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
+#pragma omp parallel for schedule(static) num_threads(nt)
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 p{b.x[i], b.y[i]};
+    const magnet::MagnetField* t = tile_for(p);  // exists now: no write
+    const magnet::Sample s = t ? t->at(p) : field_->at(p);
+    moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
+    const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
+    ffx_[i] = f.x;
+    ffy_[i] = f.y;
   }
-  ++calls_;
-  for (std::size_t i = 0; i < n; ++i) { fx[i] += dfx_[i]; fy[i] += dfy_[i]; }
 }
 
 void MagnetForce::dipole_pass(const BodyStore& b) {
@@ -178,10 +183,10 @@ template <class T> void get_vec(std::istream& i, std::vector<T>& v) {
 }  // namespace
 
 void MagnetForce::save(std::ostream& o) const {
-  put(o, calls_); put_vec(o, dipole_ids_); put_vec(o, dfx_); put_vec(o, dfy_);
+  put(o, calls_); put_vec(o, ids_); put_vec(o, ffx_); put_vec(o, ffy_); put_vec(o, dfx_); put_vec(o, dfy_); put_vec(o, moment_);
 }
 void MagnetForce::load(std::istream& in) {
-  get(in, calls_); get_vec(in, dipole_ids_); get_vec(in, dfx_); get_vec(in, dfy_);
+  get(in, calls_); get_vec(in, ids_); get_vec(in, ffx_); get_vec(in, ffy_); get_vec(in, dfx_); get_vec(in, dfy_); get_vec(in, moment_);
 }
 
 void ElectricForce::save(std::ostream& o) const {

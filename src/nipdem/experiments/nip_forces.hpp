@@ -23,6 +23,8 @@ struct MagnetConfig {
   bool dipole_dipole = true;
   double dipole_cutoff = 42e-6;    // [m]: 8 R50 (docs/magnetic.md: ~1.3 % mean truncation error)
   int dipole_interval = 10;        // steps between dipole-dipole re-evaluations
+  int field_interval = 10;         // steps between magnet-field force re-evaluations: a toner moves
+                                   // < 0.1 um in 10 steps, the field varies over >= 100 um
   int threads = 1;                 // OpenMP threads for the per-particle field force (set it to
                                    // the engine's thread count; results do not depend on it)
 };
@@ -50,6 +52,7 @@ class MagnetForce final : public engine::BodyForce {
 
  private:
   void dipole_pass(const BodyStore& b);
+  void field_pass(const BodyStore& b);
   magnet::Sample field_at(Vec2 p);
   const magnet::MagnetField* tile_for(Vec2 p);  // builds the tile if needed; null = use field_
   std::shared_ptr<const magnet::MagnetField> field_;
@@ -62,7 +65,8 @@ class MagnetForce final : public engine::BodyForce {
   MagnetConfig cfg_;
   std::vector<Vec2> moment_;
   std::vector<double> dfx_, dfy_;
-  std::vector<std::int64_t> dipole_ids_;  // body ids the held dipole forces belong to
+  std::vector<std::int64_t> ids_;         // body ids the held forces belong to
+  std::vector<double> ffx_, ffy_;         // held magnet-field force per body [N]
   long calls_ = 0;
   // cell list scratch
   std::vector<int> head_, next_;
