@@ -10,6 +10,7 @@
 
 #include <omp.h>
 
+#include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 
@@ -585,23 +586,10 @@ Energy Simulation::energy() const {
 // ---- checkpoint serialisation (raw little-endian doubles; same binary, same machine kind) ----
 namespace {
 constexpr std::uint64_t kMagic = 0x314b43504d454450ULL;  // "PDEMPCK1"
-template <class T> void put(std::ostream& o, const T& v) { o.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
-template <class T> void put_vec(std::ostream& o, const std::vector<T>& v) {
-  const std::uint64_t n = v.size();
-  put(o, n);
-  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-}
-template <class T> void get(std::istream& i, T& v) {
-  if (!i.read(reinterpret_cast<char*>(&v), sizeof(T))) throw std::runtime_error("checkpoint truncated");
-}
-template <class T> void get_vec(std::istream& i, std::vector<T>& v) {
-  std::uint64_t n;
-  get(i, n);
-  if (n > (1ULL << 34)) throw std::runtime_error("checkpoint corrupt (vector size)");
-  v.resize(n);
-  if (!i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))))
-    throw std::runtime_error("checkpoint truncated");
-}
+using binary::get;
+using binary::get_vec;
+using binary::put;
+using binary::put_vec;
 }  // namespace
 
 void Simulation::save(std::ostream& o) const {

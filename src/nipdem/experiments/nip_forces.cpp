@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/models/dipole.hpp"
@@ -162,25 +163,10 @@ ElectricForce::ElectricForce(const engine::Simulation* sim, ElectricConfig cfg) 
   cfg_.force.validate();
 }
 
-namespace {
-template <class T> void put(std::ostream& o, const T& v) { o.write(reinterpret_cast<const char*>(&v), sizeof(T)); }
-template <class T> void put_vec(std::ostream& o, const std::vector<T>& v) {
-  const std::uint64_t n = v.size();
-  put(o, n);
-  o.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
-}
-template <class T> void get(std::istream& i, T& v) {
-  if (!i.read(reinterpret_cast<char*>(&v), sizeof(T))) throw std::runtime_error("checkpoint truncated (force provider)");
-}
-template <class T> void get_vec(std::istream& i, std::vector<T>& v) {
-  std::uint64_t n;
-  get(i, n);
-  if (n > (1ULL << 32)) throw std::runtime_error("checkpoint corrupt (force provider)");
-  v.resize(n);
-  if (!i.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))))
-    throw std::runtime_error("checkpoint truncated (force provider)");
-}
-}  // namespace
+using binary::get;
+using binary::get_vec;
+using binary::put;
+using binary::put_vec;
 
 void MagnetForce::save(std::ostream& o) const {
   put(o, calls_); put_vec(o, ids_); put_vec(o, ffx_); put_vec(o, ffy_); put_vec(o, dfx_); put_vec(o, dfy_); put_vec(o, moment_);
