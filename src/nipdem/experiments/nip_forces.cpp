@@ -137,23 +137,32 @@ void MagnetForce::dipole_pass(const BodyStore& b) {
     next_[ii] = head_[c];
     head_[c] = static_cast<int>(ii);
   }
+  // One thread: each pair once, both bodies updated (Newton's third law exactly). Several
+  // threads: each body sums the forces of all its neighbours itself (every pair evaluated
+  // twice, no shared writes), so the result does not depend on the thread count either.
+  const int nt = std::max(1, cfg_.threads);
+  const bool half = nt == 1;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(nt) if (!half)
   for (std::size_t i = 0; i < n; ++i) {
     const int c = cell(i);
     const int cx = c % nx, cy = c / nx;
+    double fxi = 0.0, fyi = 0.0;
     for (int dy = -1; dy <= 1; ++dy) {
       if (cy + dy < 0 || cy + dy >= ny) continue;
       for (int dx = -1; dx <= 1; ++dx) {
         if (cx + dx < 0 || cx + dx >= nx) continue;
         for (int j = head_[(cy + dy) * nx + cx + dx]; j >= 0; j = next_[j]) {
-          if (j <= static_cast<int>(i)) continue;
+          if (half ? j <= static_cast<int>(i) : j == static_cast<int>(i)) continue;
           const Vec2 r{b.x[i] - b.x[j], b.y[i] - b.y[j]};
           if (norm2(r) >= rc2) continue;
           const Vec2 f = dipole::dipole_force(moment_[i], moment_[j], r);  // eqs. 2.4.38-2.4.39, on i
-          dfx_[i] += f.x; dfy_[i] += f.y;
-          dfx_[j] -= f.x; dfy_[j] -= f.y;
+          fxi += f.x; fyi += f.y;
+          if (half) { dfx_[j] -= f.x; dfy_[j] -= f.y; }
         }
       }
     }
+    dfx_[i] += fxi;
+    dfy_[i] += fyi;
   }
 }
 
