@@ -1,9 +1,9 @@
 #include "nipdem/experiments/nip.hpp"
 
 #include <cmath>
-#include <cstring>
 #include <sstream>
 
+#include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip_forces.hpp"
@@ -215,52 +215,36 @@ void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) 
   }
 }
 
-// ---- checkpoint ----
-namespace {
-template <class T> void put(std::string& s, const T& v) { s.append(reinterpret_cast<const char*>(&v), sizeof(T)); }
-template <class T> void get(const std::string& s, std::size_t& pos, T& v) {
-  if (pos + sizeof(T) > s.size()) throw std::runtime_error("checkpoint truncated");
-  std::memcpy(&v, s.data() + pos, sizeof(T));
-  pos += sizeof(T);
-}
-}  // namespace
-
+// ---- checkpoint: runner state, then the engine's (same binary helpers as the engine) ----
 std::string NipRun::checkpoint() const {
-  std::string s = "NIPDEMRUN1";
-  const std::uint64_t h = std::hash<std::string>{}(cfg_.resume_key);
-  put(s, h);
-  for (int i = 0; i < 4; ++i) put(s, rng_.state()[i]);
-  put(s, inserted_);
-  for (auto r : removed_) put(s, r);
-  put(s, area_debt_);
-  const std::uint64_t nr = removals_.size();
-  put(s, nr);
-  for (const auto& e : removals_) put(s, e);
-  std::ostringstream os;
-  sim_->save(os);
-  s += os.str();
-  return s;
+  std::ostringstream o;
+  o.write("NIPDEMRUN1", 10);
+  binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.resume_key)));
+  for (int i = 0; i < 4; ++i) binary::put(o, rng_.state()[i]);
+  binary::put(o, inserted_);
+  for (auto r : removed_) binary::put(o, r);
+  binary::put(o, area_debt_);
+  binary::put_vec(o, removals_);
+  sim_->save(o);
+  return o.str();
 }
 
 void NipRun::restore(const std::string& blob) {
   if (blob.compare(0, 10, "NIPDEMRUN1") != 0) throw std::runtime_error("not a nipdem run checkpoint");
-  std::size_t pos = 10;
+  std::istringstream in(blob);
+  in.ignore(10);
   std::uint64_t h;
-  get(blob, pos, h);
+  binary::get(in, h);
   if (h != std::hash<std::string>{}(cfg_.resume_key))
     throw InputError("checkpoint was written with a different configuration; --resume needs the same config and --set options (only run.end_time_s and the output intervals may change)");
   std::uint64_t st[4];
-  for (auto& v : st) get(blob, pos, v);
+  for (auto& v : st) binary::get(in, v);
   rng_.set_state(st);
-  get(blob, pos, inserted_);
-  for (auto& r : removed_) get(blob, pos, r);
-  get(blob, pos, area_debt_);
-  std::uint64_t nr;
-  get(blob, pos, nr);
-  removals_.resize(nr);
-  for (auto& e : removals_) get(blob, pos, e);
-  std::istringstream is(blob.substr(pos));
-  sim_->load(is);
+  binary::get(in, inserted_);
+  for (auto& r : removed_) binary::get(in, r);
+  binary::get(in, area_debt_);
+  binary::get_vec(in, removals_);
+  sim_->load(in);
 }
 
 nlohmann::json NipRun::describe() const {
