@@ -13,6 +13,12 @@ namespace nipdem::experiments {
 
 using constants::pi;
 
+namespace {
+// Random sequential addition stops after this many consecutive failed attempts: the pits are
+// then full to within a few per cent of the jammed fill (docs/geometry.md, "Filled pits").
+constexpr int kPitFillFailures = 400;
+}  // namespace
+
 Vec2 NipRun::drum_centre() const { return {cfg_.nip_x, cfg_.gap + cfg_.drum_radius}; }
 Vec2 NipRun::roller_centre() const { return {cfg_.nip_x, -cfg_.roller_radius}; }
 double NipRun::drum_surface_y(double x) const {
@@ -55,6 +61,8 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
     electric_ = std::make_shared<ElectricForce>(sim_.get(), cfg_.electric);
     sim_->add_force(electric_);
   }
+  // The sleeve's pits are part of its state, independent of the drum layer's prefill.
+  if (cfg_.roller_pits_filled) fill_pits_entering(true);
   if (cfg_.prefill) prefill();
 }
 
@@ -74,10 +82,16 @@ bool NipRun::place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity,
     pts.push_back(pos + rotate(spec.offsets[k] - com, angle));
     extent = std::max(extent, norm(spec.offsets[k] - com) + spec.radii[k]);
   }
-  // overlap with the drum and the roller (base circle; pits lie below it)
+  // overlap with the drum and the roller (its real surface, pits included)
+  const auto& roller = sim_->walls()[0];
+  thread_local std::vector<geometry::WallHit> hits;
   for (std::size_t k = 0; k < pts.size(); ++k) {
     if (norm(pts[k] - drum_centre()) < cfg_.drum_radius + spec.radii[k]) return false;
-    if (norm(pts[k] - roller_centre()) < cfg_.roller_radius + spec.radii[k]) return false;
+    if (norm(pts[k] - roller.centre) < roller.surface_radius(pts[k])) return false;  // centre inside the sleeve
+    hits.clear();
+    roller.query(pts[k], spec.radii[k], 0.0, hits);
+    for (const auto& h : hits)
+      if (h.gap < 0.0) return false;
   }
   const auto& dd = sim_->discs();
   const double reach = 2.0 * extent + cfg_.size.d_max();
@@ -129,6 +143,61 @@ bool NipRun::try_insert_on_roller(double x_lo, double x_hi, double h_lo, double 
   return place(spec, {x, rng_.uniform(ybot, ytop)}, angle, {0.0, 0.0}, 0.0);
 }
 
+int NipRun::fill_pits(double x_lo, double x_hi, int max_failures) {
+  if (!cfg_.roughness || !(cfg_.rough_height > 0.0) || !(x_hi > x_lo)) return 0;
+  const auto& roller = sim_->walls()[0];
+  int n = 0, failures = 0;
+  while (failures < max_failures) {
+    const double d = cfg_.size.sample(rng_);
+    engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
+    const double angle = rng_.uniform(0.0, 2.0 * pi);
+    const double x = rng_.uniform(x_lo, x_hi);
+    const double y0 = roller_surface_y(x);
+    const Vec2 pos{x, rng_.uniform(y0 - cfg_.rough_height, y0)};
+    // centre below the land level and in the open part of a pit; moving with the sleeve
+    if (norm(pos - roller.centre) > roller.surface_radius(pos) &&
+        place(spec, pos, angle, cross(roller.omega, pos - roller.centre), roller.omega)) {
+      ++n;
+      failures = 0;
+    } else {
+      ++failures;
+    }
+  }
+  return n;
+}
+
+int NipRun::fill_pits_entering(bool whole_window) {
+  if (!cfg_.roughness || !(cfg_.rough_height > 0.0)) return 0;
+  const auto& w = sim_->walls()[0];
+  const double P = w.period();
+  const double L = w.profile[1].x, Bw = w.profile[3].x - w.profile[1].x;
+  // period index of the material under x (s grows counter-clockwise, i.e. towards -x on top)
+  auto index_at = [&](double x) {
+    const Vec2 d = Vec2{x, roller_surface_y(x)} - w.centre;
+    double s = (std::atan2(d.y, d.x) - w.angle) * w.radius - w.phase;
+    return static_cast<int>(std::floor(s / P));
+  };
+  // x of the pit's upstream edge (its largest s, lowest x) now and one pass earlier
+  const double back = w.omega * ts_.dt * cfg_.insert_interval;  // rotation over one pass
+  auto edge_x = [&](int k, double extra_angle) {
+    const double phi = (k * P + L + Bw + w.phase) / w.radius + w.angle - extra_angle;
+    return w.centre.x + w.radius * std::cos(phi);
+  };
+  int added = 0;
+  const int k_lo = index_at(cfg_.x_max) - 1, k_hi = index_at(cfg_.x_min) + 1;
+  for (int k = k_lo; k <= k_hi; ++k) {
+    const double x_left = edge_x(k, 0.0);
+    const double x_right = w.centre.x + w.radius * std::cos((k * P + L + w.phase) / w.radius + w.angle);
+    // at the start: every pit (part) in the window; later: the pit whose upstream edge
+    // crossed x_min during the last pass (exactly once per pit, no bookkeeping needed)
+    const bool entering = x_left >= cfg_.x_min && edge_x(k, back) < cfg_.x_min;
+    if (!(whole_window || entering)) continue;
+    const double lo = std::max(x_left, cfg_.x_min), hi = std::min(x_right, cfg_.x_max);
+    if (hi > lo) added += fill_pits(lo, hi, kPitFillFailures);
+  }
+  return added;
+}
+
 int NipRun::fill_on_roller(double x0, double x1, double h0, double h1, double area_fraction) {
   double area = (x1 - x0) * (h1 - h0) * area_fraction;
   int n = 0, failures = 0;
@@ -144,12 +213,13 @@ int NipRun::fill_on_roller(double x0, double x1, double h0, double h1, double ar
   return n;
 }
 
-std::vector<double> NipRun::assembly_x(double max_height) const {
+std::vector<double> NipRun::assembly_x(double max_height, double min_height) const {
   std::vector<double> xs;
   const auto& b = sim_->bodies();
   for (std::size_t i = 0; i < b.x.size(); ++i) {
     if (b.x[i] < cfg_.x_min || b.x[i] > cfg_.x_max) continue;
-    if (b.y[i] - roller_surface_y(b.x[i]) < max_height) xs.push_back(b.x[i]);
+    const double h = b.y[i] - roller_surface_y(b.x[i]);
+    if (h < max_height && h > min_height) xs.push_back(b.x[i]);
   }
   return xs;
 }
@@ -203,6 +273,8 @@ void NipRun::exchange() {
   }
   // A full zone leaves the debt to the next pass; do not let it grow without bound.
   area_debt_ = std::min(area_debt_, 10.0 * pi * cfg_.size.d_max() * cfg_.size.d_max());
+  // The sleeve brings its filled pits in through x_min (it moves towards +x).
+  if (cfg_.roller_pits_filled) inserted_roller_ += fill_pits_entering(false);
 }
 
 void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) {
@@ -218,10 +290,11 @@ void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) 
 // ---- checkpoint: runner state, then the engine's (same binary helpers as the engine) ----
 std::string NipRun::checkpoint() const {
   std::ostringstream o;
-  o.write("NIPDEMRUN1", 10);
+  o.write("NIPDEMRUN2", 10);
   binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.resume_key)));
   for (int i = 0; i < 4; ++i) binary::put(o, rng_.state()[i]);
   binary::put(o, inserted_);
+  binary::put(o, inserted_roller_);
   for (auto r : removed_) binary::put(o, r);
   binary::put(o, area_debt_);
   binary::put_vec(o, removals_);
@@ -230,7 +303,7 @@ std::string NipRun::checkpoint() const {
 }
 
 void NipRun::restore(const std::string& blob) {
-  if (blob.compare(0, 10, "NIPDEMRUN1") != 0) throw std::runtime_error("not a nipdem run checkpoint");
+  if (blob.compare(0, 10, "NIPDEMRUN2") != 0) throw std::runtime_error("not a nipdem run checkpoint of this version");
   std::istringstream in(blob);
   in.ignore(10);
   std::uint64_t h;
@@ -241,6 +314,7 @@ void NipRun::restore(const std::string& blob) {
   for (auto& v : st) binary::get(in, v);
   rng_.set_state(st);
   binary::get(in, inserted_);
+  binary::get(in, inserted_roller_);
   for (auto& r : removed_) binary::get(in, r);
   binary::get(in, area_debt_);
   binary::get_vec(in, removals_);

@@ -44,15 +44,22 @@ class NipRun {
   // Fills [x0, x1] between heights h0 and h1 above the roller surface with resting toner at
   // the given area fraction (the reduction experiment's assembly, §4.6). Returns the count.
   int fill_on_roller(double x0, double x1, double h0, double h1, double area_fraction);
-  // x of the bodies that belong to the assembly on the roller: centre of mass closer to the
-  // roller than `max_height` [m] (front/back positions, §4.6, §5.1).
-  std::vector<double> assembly_x(double max_height) const;
+  // Fills the roughness pits of the sleeve under [x_lo, x_hi] with toner moving with the
+  // sleeve (random sequential addition, centres below the land level, until `max_failures`
+  // consecutive attempts fail). Returns the count. No-op on a smooth roller.
+  int fill_pits(double x_lo, double x_hi, int max_failures);
+  // x of the bodies that belong to the assembly on the roller: centre of mass between
+  // `min_height` and `max_height` above the roller's base circle [m] (front/back positions,
+  // §4.6, §5.1). A min_height of about d50/2 leaves out the toner carried in filled pits.
+  std::vector<double> assembly_x(double max_height, double min_height = -1.0) const;
 
   engine::Simulation& sim() { return *sim_; }
   const engine::Simulation& sim() const { return *sim_; }
   const NipConfig& config() const { return cfg_; }
   const TimeStep& time_step() const { return ts_; }
   std::int64_t inserted() const { return inserted_; }
+  // Bodies brought in by the sleeve in its pits after the start (inflow.roller_pits = "filled").
+  std::int64_t inserted_on_roller() const { return inserted_roller_; }
   std::int64_t removed(Exit e) const { return removed_[static_cast<int>(e)]; }
   const std::vector<RemovalEvent>& removals() const { return removals_; }
   // The electric force provider (null unless [electric] enabled).
@@ -83,12 +90,16 @@ class NipRun {
   bool try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi);
   bool place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega);
   void prefill();
+  // Fills the pits of the whole window (start) or the pit(s) that entered through x_min
+  // during the last inflow pass; returns the count.
+  int fill_pits_entering(bool whole_window);
 
   NipConfig cfg_;
   TimeStep ts_;
   std::unique_ptr<engine::Simulation> sim_;
   Rng rng_;
   std::int64_t inserted_ = 0;
+  std::int64_t inserted_roller_ = 0;
   std::int64_t removed_[3] = {0, 0, 0};
   double area_debt_ = 0.0;  // toner area still to insert [m^2]
   std::vector<RemovalEvent> removals_;

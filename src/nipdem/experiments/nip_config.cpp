@@ -114,6 +114,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     c.area_fraction = s.number("area_fraction", 0.0, 0.85, c.area_fraction);
     c.insert_interval = static_cast<int>(s.integer("interval_steps", 1, 1000000, c.insert_interval));
     c.prefill = s.boolean("prefill", c.prefill);
+    c.roller_pits_filled = s.choice("roller_pits", {"empty", "filled"}, "empty") == "filled";
     s.finish();
   }
   {

@@ -66,6 +66,10 @@ struct NipConfig {
   double area_fraction = 0.5;        // of that layer (2D) [-]
   int insert_interval = 200;         // steps between inflow/outflow passes
   bool prefill = true;               // start with the layer over the whole window
+  // Roughness pits of the sleeve entering the window (and at the start) are filled with
+  // toner (docs/geometry.md "Filled pits"): the steady state of a sleeve whose pits the
+  // supply roller does not empty.
+  bool roller_pits_filled = false;
   // [gravity]
   Vec2 gravity{0.0, -9.81};
   // [magnet]

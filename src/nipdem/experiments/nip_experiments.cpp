@@ -80,7 +80,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     const double h = 0.5 * run.config().gap;
     while (run.sim().time() < f.max_time_s) {
       run.advance_to(run.sim().time() + f.sample_interval_s);
-      const auto xs = run.assembly_x(h);
+      const auto xs = run.assembly_x(h, run.config().roller_pits_filled ? 0.5 * run.config().size.d50 : -1.0);
       if (xs.size() < 8) continue;  // no assembly (yet)
       const auto e = analysis::assembly_extent(run.sim().time(), xs, eo);
       t.push_back(e.t); front.push_back(e.front); back.push_back(e.back);
@@ -154,10 +154,15 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
     const double half_dt = 0.5 * run.time_step().dt;  // time lands within dt/2 of a target
     while (run.sim().time() < r.time_s - half_dt) {
       run.advance_to(std::min(r.time_s, run.sim().time() + r.sample_interval_s));
-      const auto xs = run.assembly_x(r.pile_height_m * 2.0);
+      // the assembly above the land level: toner in filled pits is the sleeve's, not the pile's
+      const auto xs = run.assembly_x(r.pile_height_m * 2.0, run.config().roller_pits_filled ? 0.5 * run.config().size.d50 : -1.0);
       if (xs.size() >= 8) ext.push_back(analysis::assembly_extent(run.sim().time(), xs, eo));
     }
-    json res{{"r", r.cohesion_ratios[i]}, {"initial_particles", n0}, {"removed", run.removed(Exit::returned) + run.removed(Exit::developed)},
+    // removed from the assembly = what left the window minus what the sleeve brought in its
+    // filled pits (those pass through; they are not the assembly's loss)
+    const auto out = run.removed(Exit::returned) + run.removed(Exit::developed);
+    json res{{"r", r.cohesion_ratios[i]}, {"initial_particles", n0}, {"removed", out - run.inserted_on_roller()},
+             {"left_window", out}, {"brought_in_pits", run.inserted_on_roller()},
              {"lost", run.removed(Exit::lost)}, {"time_s", run.sim().time()}};
     if (ext.size() >= 3) {
       const auto rs = analysis::reduction_speed(ext);

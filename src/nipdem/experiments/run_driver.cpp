@@ -141,6 +141,7 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
       {"particles_in_window", run.sim().bodies().x.size()},
       {"discs_in_window", run.sim().discs().x.size()},
       {"inserted", run.inserted()},
+      {"inserted_in_roller_pits", run.inserted_on_roller()},
       {"developed", run.removed(Exit::developed)},
       {"returned", run.removed(Exit::returned)},
       {"lost", run.removed(Exit::lost)},

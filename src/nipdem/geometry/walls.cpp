@@ -94,6 +94,22 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   }
 }
 
+double Wall::surface_radius(Vec2 p) const {
+  if (kind != Kind::cylinder || !rough()) return radius;
+  const double P = period();
+  const Vec2 d = p - centre;
+  double s = (std::atan2(d.y, d.x) - angle) * radius - phase;
+  s = std::fmod(s, P);
+  if (s < 0) s += P;
+  for (std::size_t j = 1; j < profile.size(); ++j) {
+    if (s <= profile[j].x) {
+      const double t = (s - profile[j - 1].x) / (profile[j].x - profile[j - 1].x);
+      return radius - (profile[j - 1].y + t * (profile[j].y - profile[j - 1].y));
+    }
+  }
+  return radius - profile.back().y;
+}
+
 void Wall::validate() const {
   const std::string where = "wall '" + name + "'";
   if (kind == Kind::plane) {

@@ -68,6 +68,10 @@ struct Wall {
   }
   // Advances the prescribed motion by dt.
   void advance(double dt) { angle += omega * dt; }
+  // Distance from the axis of the cylinder's surface in the direction of p (radius minus the
+  // profile depth there; the radius for a smooth cylinder). A point p outside a roller lies in
+  // the open space iff |p - centre| > surface_radius(p).
+  double surface_radius(Vec2 p) const;
   // World position of profile point (s, depth) in period k, at the current angle.
   Vec2 profile_point(int k, Vec2 sd) const;
   // Validates the geometry; throws InputError naming the wall and key.
