@@ -93,6 +93,8 @@ TEST(NipCli, BadInputExitsTwoNamingFileKeyAndRange) {
       {"negative_radius", "", "toner.d50_m", "out of range"},
       {"gap_too_small", "", "geometry.gap_m", "largest particle"},
       {"dt_above_bound", "", "run.dt_s", "stability bound"},
+      {"bad_pits", "", "inflow.roller_pits", "filled"},
+      {"assembly_outside", "", "initial_assembly.x_min_m", "outside the window"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -107,6 +109,8 @@ TEST(NipCli, BadInputExitsTwoNamingFileKeyAndRange) {
     if (c.name == "negative_radius") set = "--set toner.d50_m=-1e-6";
     if (c.name == "gap_too_small") set = "--set geometry.gap_m=12e-6";
     if (c.name == "dt_above_bound") set = "--set run.dt_s=1e-6";
+    if (c.name == "bad_pits") set = "--set inflow.roller_pits=\\\"full\\\"";
+    if (c.name == "assembly_outside") set = "--set initial_assembly.enabled=true --set initial_assembly.x_min_m=-0.01";
     io::write_file_atomic(cfg, text);
     const auto r = run_cli("run " + cfg.string() + " --out " + (d / c.name).string() + " " + set);
     EXPECT_EQ(r.status, 2) << r.err;

@@ -64,6 +64,10 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   // The sleeve's pits are part of its state, independent of the drum layer's prefill.
   if (cfg_.roller_pits_filled) fill_pits_entering(true);
   if (cfg_.prefill) prefill();
+  if (cfg_.assembly.enabled) {
+    const auto& a = cfg_.assembly;
+    fill_on_roller(a.x_min, a.x_max, 0.0, a.height > 0.0 ? a.height : 1.0, a.area_fraction);  // 1 m: up to the drum
+  }
 }
 
 bool NipRun::place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega) {
@@ -199,7 +203,14 @@ int NipRun::fill_pits_entering(bool whole_window) {
 }
 
 int NipRun::fill_on_roller(double x0, double x1, double h0, double h1, double area_fraction) {
-  double area = (x1 - x0) * (h1 - h0) * area_fraction;
+  // area of the region, clipped by the drum (the local gap grows away from the nip)
+  double area = 0.0;
+  constexpr int kSamples = 200;
+  for (int k = 0; k < kSamples; ++k) {
+    const double x = x0 + (k + 0.5) * (x1 - x0) / kSamples;
+    area += std::max(0.0, std::min(h1, drum_surface_y(x) - roller_surface_y(x)) - h0) * (x1 - x0) / kSamples;
+  }
+  area *= area_fraction;
   int n = 0, failures = 0;
   while (area > 0.0 && failures < 20000) {
     if (try_insert_on_roller(x0, x1, h0, h1)) {

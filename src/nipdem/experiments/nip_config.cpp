@@ -118,6 +118,16 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     s.finish();
   }
   {
+    auto s = top.sub("initial_assembly");
+    auto& a = c.assembly;
+    a.enabled = s.boolean("enabled", a.enabled);
+    a.x_min = s.number("x_min_m", -0.05, 0.05, a.x_min);
+    a.x_max = s.number("x_max_m", -0.05, 0.05, a.x_max);
+    a.height = s.number("height_m", 0.0, 1e-2, a.height);
+    a.area_fraction = s.number("area_fraction", 0.05, 0.75, a.area_fraction);
+    s.finish();
+  }
+  {
     auto s = top.sub("gravity");
     auto g = s.numbers("vector_m_per_s2", 2, -1e6, 1e6, {c.gravity.x, c.gravity.y});
     c.gravity = {g[0], g[1]};
@@ -190,6 +200,14 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     throw_input(file, "inflow.layer_thickness_m", fmt::format("{:g}", c.layer_thickness), "layer thicker than the gap", fmt::format("[0, {:g}]", c.gap));
   if (c.x_max - c.nip_x > 0.5 * std::min(c.drum_radius, c.roller_radius) || c.nip_x - c.x_min > 0.5 * std::min(c.drum_radius, c.roller_radius))
     throw_input(file, "geometry.window_x_max_m", fmt::format("{:g}", c.x_max), "window reaches beyond half a roller radius from the nip");
+  if (c.assembly.enabled) {
+    if (!(c.assembly.x_max > c.assembly.x_min))
+      throw_input(file, "initial_assembly.x_max_m", fmt::format("{:g}", c.assembly.x_max), "must exceed initial_assembly.x_min_m",
+                  fmt::format("> {:g}", c.assembly.x_min));
+    if (c.assembly.x_min < c.x_min || c.assembly.x_max > c.x_max)
+      throw_input(file, "initial_assembly.x_min_m", fmt::format("[{:g}, {:g}]", c.assembly.x_min, c.assembly.x_max), "assembly outside the window",
+                  fmt::format("within [{:g}, {:g}]", c.x_min, c.x_max));
+  }
   std::ostringstream ss;
   ss << root;
   c.resolved_toml = ss.str();

@@ -70,6 +70,14 @@ struct NipConfig {
   // toner (docs/geometry.md "Filled pits"): the steady state of a sleeve whose pits the
   // supply roller does not empty.
   bool roller_pits_filled = false;
+  // [initial_assembly]: toner resting on the roller at the start, e.g. a DI toner assembly that
+  // fills the nip as in the clean state of §5.1 (print runs start from it, §5.2-5.3).
+  struct InitialAssembly {
+    bool enabled = false;
+    double x_min = -250e-6, x_max = 150e-6;  // [m], magnet-edge frame
+    double height = 0.0;                     // above the lands [m]; 0 = up to the drum
+    double area_fraction = 0.6;              // 2D fill by random sequential addition [-]
+  } assembly;
   // [gravity]
   Vec2 gravity{0.0, -9.81};
   // [magnet]
