@@ -4,12 +4,14 @@
 //
 // State: black preset (real stiffness unless --set collision.stiffness_scale=..), filled
 // sleeve pits, the magnet with dipole-dipole, and a dense assembly that bridges the gap from
-// the roller to the drum over [--x0, --x1], the drum track at 40 V throughout. After
+// the roller to the drum over [--x0, --x1] in a window of -300..+700 um (the configuration of
+// examples/print_line_black.toml), the drum track at 40 V throughout. After
 // `--settle` steps (contacts and conduction paths form, toner near the drum charges) the
 // next `--steps` are timed. Both runs start from the same seed, hence the same fill.
 //
-// Usage: bench_print [--steps N=2000] [--settle N=2000] [--threads T=1] [--x0 M=-250e-6]
-//                    [--x1 M=150e-6] [--set key=value ...]
+// Usage: bench_print [--steps N=2000] [--settle N=20000] [--threads T=1] [--repeat R=3] [--x0 M=-250e-6]
+//                    [--x1 M=450e-6] [--set key=value ...]
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -72,9 +74,9 @@ void print(const char* label, const Result& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  long steps = 2000, settle = 2000;
-  int threads = 1;
-  double x0 = -250e-6, x1 = 150e-6;
+  long steps = 2000, settle = 20000;
+  int threads = 1, repeat = 3;
+  double x0 = -250e-6, x1 = 450e-6;
   std::vector<std::string> extra;
   for (int a = 1; a < argc; ++a) {
     const std::string k = argv[a];
@@ -85,16 +87,17 @@ int main(int argc, char** argv) {
     if (k == "--steps") steps = std::stol(val());
     else if (k == "--settle") settle = std::stol(val());
     else if (k == "--threads") threads = std::stoi(val());
+    else if (k == "--repeat") repeat = std::max(1, std::stoi(val()));
     else if (k == "--x0") x0 = std::stod(val());
     else if (k == "--x1") x1 = std::stod(val());
     else if (k == "--set") extra.push_back(val());
     else {
-      std::fprintf(stderr, "usage: bench_print [--steps N] [--settle N] [--threads T] [--x0 M] [--x1 M] [--set key=value]\n");
+      std::fprintf(stderr, "usage: bench_print [--steps N] [--settle N] [--threads T] [--repeat R] [--x0 M] [--x1 M] [--set key=value]\n");
       return 2;
     }
   }
   std::vector<std::string> base = {
-      "geometry.window_x_min_m=-300e-6", "geometry.window_x_max_m=300e-6", "inflow.layer_thickness_m=0",
+      "geometry.window_x_min_m=-300e-6", "geometry.window_x_max_m=700e-6", "inflow.layer_thickness_m=0",
       "inflow.prefill=false",            "inflow.roller_pits=\"filled\"",  "run.threads=" + std::to_string(threads),
       "output.vtk=false",                "print.pattern=\"line\"",         "print.voltage_V=40",
       "print.start_m=-0.5",                "print.length_m=1",               "electric.charge_preset=\"black\"",
@@ -105,13 +108,22 @@ int main(int argc, char** argv) {
     auto off = base, on = base;
     off.push_back("electric.enabled=false");
     on.push_back("electric.enabled=true");
-    const Result a = run(off, x0, x1, settle, steps, true);
-    print("electric.enabled=false:", a);
-    std::fflush(stdout);
-    const Result b = run(on, x0, x1, settle, steps, false);
-    print("charge model + force:", b);
+    // Interleaved repeats; the fastest of each kind is the least disturbed by other jobs on
+    // a shared machine (the work is identical from repeat to repeat).
+    Result a, b;
+    for (int k = 0; k < repeat; ++k) {
+      const Result ak = run(off, x0, x1, settle, steps, k == 0);
+      print("electric.enabled=false:", ak);
+      std::fflush(stdout);
+      const Result bk = run(on, x0, x1, settle, steps, false);
+      print("charge model + force:", bk);
+      std::fflush(stdout);
+      if (k == 0 || ak.wall_s < a.wall_s) a = ak;
+      if (k == 0 || bk.wall_s < b.wall_s) b = bk;
+    }
     const double ca = a.wall_s / (static_cast<double>(a.discs) * steps);
     const double cb = b.wall_s / (static_cast<double>(b.discs) * steps);
+    std::printf("fastest of %d interleaved repeats each\n", repeat);
     std::printf("RESULT print threads=%d particles=%zu disc_steps_per_s_off=%.4g disc_steps_per_s_on=%.4g charge_overhead_pct=%.1f\n",
                 threads, b.bodies, a.rate, b.rate, 100.0 * (cb / ca - 1.0));
   } catch (const InputError& e) {
