@@ -106,6 +106,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--vmax", v->v_max_V, "give up above this voltage [V]")->capture_default_str();
     sub->add_option("--seeds", v->seeds, "independent realizations")->capture_default_str();
     sub->add_option("--line-length", v->print.line_length_m, "printed line length on the drum [m]")->capture_default_str();
+    sub->add_option("--line-start", v->print.line_start_m, "drum position where the line starts [m] (s = 0 at the nip at t = 0)")->capture_default_str();
+    sub->add_option("--extra-time", v->print.extra_time_s, "run this long after the line's end has left the window [s]")->capture_default_str()->check(CLI::Range(0.0, 1.0));
     sub->callback([=] { finish(c, "vo-level", [&] { return vo_level(c->o, *v); }); });
   }
   {
@@ -115,6 +117,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
     add_common(sub, c, "edge-sharpness");
     sub->add_option("--realizations", e->realizations, "printed lines")->capture_default_str();
     sub->add_option("--line-length", e->print.line_length_m, "printed line length on the drum [m]")->capture_default_str();
+    sub->add_option("--line-start", e->print.line_start_m, "drum position where the line starts [m] (s = 0 at the nip at t = 0)")->capture_default_str();
+    sub->add_option("--extra-time", e->print.extra_time_s, "run this long after the line's end has left the window [s] (printing goes on after the track is off)")->capture_default_str()->check(CLI::Range(0.0, 1.0));
     sub->add_option("--bootstrap", e->bootstrap, "bootstrap resamples")->capture_default_str();
     sub->callback([=] { finish(c, "edge-sharpness", [&] { return edge_sharpness(c->o, *e); }); });
   }
