@@ -11,7 +11,9 @@
 #include <Eigen/SparseCholesky>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "nipdem/core/rng.hpp"
@@ -54,6 +56,7 @@ struct Result {
   int analytic, schwarz, fd;
   int factorisations;
   int unconverged;  // solves that hit max_iterations
+  double fd_groups = 0, fd_kept = 0, fd_factorisations = 0;  // per warm re-solve (mean)
 };
 
 Result run(int n, int cells, int resolves, std::uint64_t seed) {
@@ -86,6 +89,9 @@ Result run(int n, int cells, int resolves, std::uint64_t seed) {
     iters += solver.stats().iterations;
     r.unconverged += !solver.stats().converged;
     r.factorisations += solver.stats().coarse_factorisations;
+    r.fd_groups += double(solver.stats().fd_groups) / resolves;
+    r.fd_kept += double(solver.stats().fd_kept) / resolves;
+    r.fd_factorisations += double(solver.stats().fd_factorisations) / resolves;
   }
   r.warm_s = seconds_since(t0) / resolves;
   r.warm_iterations = iters / resolves;
@@ -125,9 +131,23 @@ void coarse_solver_comparison(int cells) {
   std::printf("  %4dx%-4d  LDLT factor %8.2f ms  solve %7.3f ms | CG+IC(1e-10) setup %7.2f ms  solve %8.2f ms (%d its)\n",
               cells, cells, 1e3 * factor, 1e3 * solve, 1e3 * cg_setup, 1e3 * cg_solve, int(cg.iterations()));
 }
+void print_row(const char* label, const Result& r) {
+  std::printf("  %9s %10.2f %6.0f %12.3f %8.2f   %d/%d/%d  %d   %.1f/%.1f/%.1f\n", label, 1e3 * r.cold_s, r.cold_iterations,
+              1e3 * r.warm_s, r.warm_iterations, r.analytic, r.schwarz, r.fd, r.unconverged, r.fd_groups, r.fd_kept,
+              r.fd_factorisations);
+}
+const char* kHeader = "  %9s %10s %6s %12s %8s   %s\n";
+const char* kColumns = "analytic/schwarz/fd  unconverged  fd clusters/kept/LU per re-solve";
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 5 && std::strcmp(argv[1], "--case") == 0) {  // --case DISCS CELLS RESOLVES
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+    const Result r = run(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), 42);
+    std::printf(kHeader, "discs", "cold [ms]", "its", "warm [ms]", "its", kColumns);
+    print_row(argv[2], r);
+    return 0;
+  }
   const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const int resolves = quick ? 10 : 100;
@@ -144,18 +164,16 @@ int main(int argc, char** argv) {
                 r.fd, r.unconverged);
   }
   std::printf("\nTime per solve vs number of discs (coarse grid 100x100, H = 2R; 20 warm re-solves, 5 for 200):\n");
-  std::printf("  %5s %10s %6s %12s %8s   %s\n", "discs", "cold [ms]", "its", "warm [ms]", "its", "analytic/schwarz/fd  unconverged");
-  for (int n : {25, 50, 100, 200}) {
+  std::printf(kHeader, "discs", "cold [ms]", "its", "warm [ms]", "its", kColumns);
+  for (int n : {25, 50, 100, 200, 400}) {
     const Result r = run(n, 100, quick ? 3 : (n > 100 ? 5 : 20), 42);
-    std::printf("  %5d %10.2f %6.0f %12.3f %8.2f   %d/%d/%d  %d\n", n, 1e3 * r.cold_s, r.cold_iterations, 1e3 * r.warm_s,
-                r.warm_iterations, r.analytic, r.schwarz, r.fd, r.unconverged);
+    print_row(std::to_string(n).c_str(), r);
   }
   std::printf("\nTime per solve vs coarse grid (100 discs, 10 warm re-solves):\n");
-  std::printf("  %9s %10s %6s %12s %8s   %s\n", "grid", "cold [ms]", "its", "warm [ms]", "its", "analytic/schwarz/fd  unconverged");
+  std::printf(kHeader, "grid", "cold [ms]", "its", "warm [ms]", "its", kColumns);
   for (int cells : {50, 100, 200, 400}) {
     const Result r = run(100, cells, quick ? 3 : 10, 42);
-    std::printf("  %4dx%-4d %10.2f %6.0f %12.3f %8.2f   %d/%d/%d  %d\n", cells, cells, 1e3 * r.cold_s, r.cold_iterations,
-                1e3 * r.warm_s, r.warm_iterations, r.analytic, r.schwarz, r.fd, r.unconverged);
+    print_row((std::to_string(cells) + "x" + std::to_string(cells)).c_str(), r);
   }
   std::printf("\nCoarse solver choice (5-point Laplacian, Dirichlet box):\n");
   for (int cells : {100, 200, 400}) coarse_solver_comparison(cells);

@@ -40,6 +40,10 @@ struct LdcSolver::Impl {
   std::vector<Vec2> forces;
   SolveStats stats;
   bool have_warm = false;
+  // Finite-difference problems of the previous solve, reused by a group with the same rectangle,
+  // refinement and members (the factorisation is kept while no fine node changes its kind).
+  std::vector<Group> previous_groups;
+  int fd_factorisations_before = 0;
 
   explicit Impl(const Params& prm) : p(prm), grid(prm), coarse(grid) {
     const int n = grid.size();
@@ -128,8 +132,20 @@ void LdcSolver::Impl::setup_fd_group(int gi) {
                                    g.j0 == 0 && grid.neumann_y_min(), g.j1 == ny - 1 && grid.neumann_y_max()};
   std::vector<FdConductor> cs;
   for (int k : g.members) cs.push_back({false, discs[k].center_m, discs[k].radius_m, {}, {}, discs[k].charge_C_per_m});
-  gr.fd = std::make_unique<FdLocalProblem>(grid.node(g.i0, g.j0), grid.hx() / r, grid.hy() / r, (g.i1 - g.i0) * r,
-                                           (g.j1 - g.j0) * r, neu, std::move(cs), p.permittivity_F_per_m);
+  ++stats.fd_groups;
+  for (Group& old : previous_groups) {
+    const LocalGroup& o = old.def;
+    if (!old.fd || o.i0 != g.i0 || o.i1 != g.i1 || o.j0 != g.j0 || o.j1 != g.j1 || o.refinement != r ||
+        o.members != g.members)
+      continue;
+    gr.fd = std::move(old.fd);
+    fd_factorisations_before += gr.fd->counters().factorisations;
+    if (gr.fd->update_conductors(std::move(cs))) ++stats.fd_kept;
+    break;
+  }
+  if (!gr.fd)
+    gr.fd = std::make_unique<FdLocalProblem>(grid.node(g.i0, g.j0), grid.hx() / r, grid.hy() / r, (g.i1 - g.i0) * r,
+                                             (g.j1 - g.j0) * r, neu, std::move(cs), p.permittivity_F_per_m);
   // Γ = the sides of the rectangle that are not box sides.
   const bool open[4] = {g.i0 > 0, g.i1 < nx - 1, g.j0 > 0, g.j1 < ny - 1};
   const double eps_depth = 1e-9 * std::min(grid.hx(), grid.hy());
@@ -172,7 +188,9 @@ void LdcSolver::Impl::setup_geometry() {
   const int nd = int(discs.size());
   mark_conductor_nodes();
   const std::vector<LocalGroup> defs = build_local_groups(grid, discs, p);
+  previous_groups = std::move(groups);
   groups.clear();
+  fd_factorisations_before = 0;
   groups.resize(defs.size());
   group_of_disc.assign(nd, -1);
   slot_of_disc.assign(nd, -1);
@@ -193,6 +211,7 @@ void LdcSolver::Impl::setup_geometry() {
     if (defs[gi].method != LocalMethod::finite_difference) setup_annulus_group(gi);
   for (int gi = 0; gi < int(defs.size()); ++gi)
     if (defs[gi].method == LocalMethod::finite_difference) setup_fd_group(gi);
+  previous_groups.clear();
   select_defect_nodes();
   gamma_prev.assign(gamma_pts.size(), 0.0);
   gamma_cur.assign(gamma_pts.size(), 0.0);
@@ -251,6 +270,7 @@ void LdcSolver::Impl::run() {
   stats = SolveStats{};
   const bool warm = have_warm && int(g.size()) == nd;
   if (!warm) {
+    groups.clear();  // a cold solve builds every finite-difference problem afresh
     g.assign(nd, p.initial_potential_V);
     std::fill(u.begin(), u.end(), 0.0);
     std::fill(source.begin(), source.end(), 0.0);
@@ -304,6 +324,10 @@ void LdcSolver::Impl::run() {
       break;
     }
   }
+  int fd_factorisations = 0;
+  for (const Group& gr : groups)
+    if (gr.fd) fd_factorisations += gr.fd->counters().factorisations;
+  stats.fd_factorisations = fd_factorisations - fd_factorisations_before;
   forces.assign(nd, Vec2{});
   for (int k = 0; k < nd; ++k) {
     const Group& gr = groups[group_of_disc[k]];
