@@ -66,8 +66,7 @@ class FdLocalProblem {
   // earlier matrix (stale), and iterative-refinement steps.
   struct Counters { int factorisations = 0, stale_solves = 0, refinement_steps = 0; };
   const Counters& counters() const { return counters_; }
-  // Componentwise backward error max_i |b - A x|_i / (|A| |x| + |b|)_i of the last solve that
-  // measured it (the first after each factorisation, and every solve with a kept factorisation).
+  // Componentwise backward error max_i |b - A x|_i / (|A| |x| + |b|)_i of the last solve.
   double backward_error() const { return backward_error_; }
 
   int nx() const { return nx_; }
@@ -106,10 +105,10 @@ class FdLocalProblem {
   bool have_solution_ = false;         // impl_->x holds the previous solution (initial guess)
   void assemble();                     // kind_, unknown_, couplings_, flux_radius_, matrix
   void factorize();
-  // Iterative refinement of impl_->x for impl_->rhs with the current matrix while the residual
-  // falls by the factor min_reduction per step (at most max_steps); if `measure`, sets
-  // backward_error_. Returns the steps.
-  int refine(int max_steps, bool measure, double min_reduction);
+  // Iterative refinement of impl_->x for impl_->rhs with the current matrix until the backward
+  // error is at round-off or while the residual falls by the factor min_reduction per step (at
+  // most max_steps); sets backward_error_. Returns the steps.
+  int refine(int max_steps, double min_reduction);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
