@@ -64,7 +64,28 @@ struct LdcSolver::Impl {
   void local_solve();
   double local_value(const Group& gr, int n) const;
   void run();
+  void aitken_step(int it);
+  std::vector<double> source_prev, g_prev;
+  int last_extrapolation = 0;
 };
+
+// Aitken extrapolation of the LDC state (defect d and potentials g, which determine the next
+// iterate). In dense configurations the iteration converges with one dominant factor ρ shared by
+// all discs (measured 0.71 for 200 discs in 1 mm², docs/ldc.md); once the ratio of successive
+// potential changes is steady (two ratios within 2 %, 0.3 < ρ < 0.95), the geometric tail is
+// summed: x += ρ/(1-ρ) (x_i - x_{i-1}). The iteration then continues from the extrapolated state,
+// so the stopping test still compares two plain iterations. At most every third iteration.
+void LdcSolver::Impl::aitken_step(int it) {
+  const auto& pc = stats.potential_change;
+  if (it < 4 || it - last_extrapolation < 3) return;
+  const double r1 = pc[it - 1] / pc[it - 2], r0 = pc[it - 2] / pc[it - 3];
+  if (!(r1 > 0.3 && r1 < 0.95) || std::abs(r1 - r0) > 0.02 * r1) return;
+  const double f = r1 / (1.0 - r1);
+  for (std::size_t n = 0; n < source.size(); ++n) source[n] += f * (source[n] - source_prev[n]);
+  for (std::size_t k = 0; k < g.size(); ++k) g[k] += f * (g[k] - g_prev[k]);
+  last_extrapolation = it;
+  ++stats.extrapolations;
+}
 
 void LdcSolver::Impl::node_range(Vec2 c, double r, int& i0, int& i1, int& j0, int& j1) const {
   const Vec2 o = grid.lower();
@@ -276,6 +297,7 @@ void LdcSolver::Impl::run() {
     std::fill(source.begin(), source.end(), 0.0);
   }
   g_new.assign(nd, 0.0);
+  last_extrapolation = 0;
   setup_geometry();
   // Defect entries outside the new defect region (from a previous geometry) are dropped.
   std::vector<char> in_defect(grid.size(), 0);
@@ -306,10 +328,12 @@ void LdcSolver::Impl::run() {
         w[n] = cond_disc[n] >= 0 ? g_new[cond_disc[n]] : local_value(gr, n);
         if (!coarse.is_dirichlet(n)) kappa = std::max(kappa, std::abs(w[n] - u[n]));
       }
+    if (p.aitken) source_prev = source;
     for (const Group& gr : groups)
       for (int n : gr.defect) source[n] = grid.laplacian(w, n % nx, n / nx);
     stats.kappa.push_back(kappa);
     double dg = 0.0, scale = 0.0;
+    g_prev = g;
     for (int k = 0; k < nd; ++k) {
       dg = std::max(dg, std::abs(g_new[k] - g[k]));
       scale = std::max(scale, std::abs(g_new[k]));
@@ -323,6 +347,7 @@ void LdcSolver::Impl::run() {
       stats.converged = true;
       break;
     }
+    if (p.aitken) aitken_step(it);
   }
   int fd_factorisations = 0;
   for (const Group& gr : groups)

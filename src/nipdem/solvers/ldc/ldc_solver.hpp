@@ -35,6 +35,7 @@ struct SolveStats {
   int fd_groups = 0;                 // finite-difference local problems in this solve
   int fd_kept = 0;                   // ... that kept their matrix factorisation from the previous solve
   int fd_factorisations = 0;         // LU factorisations of finite-difference matrices during this solve
+  int extrapolations = 0;            // Aitken steps (Params::aitken)
 };
 
 class LdcSolver {

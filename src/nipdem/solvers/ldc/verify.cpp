@@ -24,6 +24,7 @@ Params problem_381(int cells) {
   p.permittivity_F_per_m = 1.0;
   p.initial_potential_V = 0.1;
   p.dirichlet_conductor_nodes = true;  // the thesis formulation (3.2.2)
+  p.aitken = false;                    // Tables 3.2-3.3 measure the plain iteration
   return p;
 }
 // (3.8.1) prescribes \oint du/dn ds = 1.13 over the particle boundary. Read with n the outward
