@@ -67,20 +67,34 @@ struct LdcSolver::Impl {
   void aitken_step(int it);
   std::vector<double> source_prev, g_prev;
   int last_extrapolation = 0;
+  bool aitken_off = false;
 };
 
 // Aitken extrapolation of the LDC state (defect d and potentials g, which determine the next
 // iterate). In dense configurations the iteration converges with one dominant factor ρ shared by
-// all discs (measured 0.71 for 200 discs in 1 mm², docs/ldc.md); once the ratio of successive
-// potential changes is steady (two ratios within 2 %, 0.3 < ρ < 0.95), the geometric tail is
+// all discs (measured 0.71 for 200 discs in 1 mm², docs/ldc.md); once both quantities of the
+// stopping test (change of g and change of u^H on Γ) shrink by the same steady factor (the last
+// two ratios of each within 2 %, the two within 5 %, 0.3 < ρ < 0.95), the geometric tail is
 // summed: x += ρ/(1-ρ) (x_i - x_{i-1}). The iteration then continues from the extrapolated state,
-// so the stopping test still compares two plain iterations. At most every third iteration.
+// so the stopping test still compares two plain iterations. At most every third iteration; if
+// the first plain change after an extrapolation is larger than the one before it, the iteration
+// is not a single geometric mode and extrapolation stops for this solve.
 void LdcSolver::Impl::aitken_step(int it) {
   const auto& pc = stats.potential_change;
-  if (it < 4 || it - last_extrapolation < 3) return;
-  const double r1 = pc[it - 1] / pc[it - 2], r0 = pc[it - 2] / pc[it - 3];
-  if (!(r1 > 0.3 && r1 < 0.95) || std::abs(r1 - r0) > 0.02 * r1) return;
-  const double f = r1 / (1.0 - r1);
+  const auto& dl = stats.delta;  // dl[j] compares coarse solves j+1 and j+2
+  if (last_extrapolation > 0 && it == last_extrapolation + 1 && pc[it - 1] > pc[it - 2]) aitken_off = true;
+  if (aitken_off || it < 5 || it - last_extrapolation < 3) return;
+  auto steady = [](double a, double b, double c, double& r) {
+    if (!(a > 0 && b > 0)) return false;
+    const double r1 = c / b, r0 = b / a;
+    r = r1;
+    return r1 > 0.3 && r1 < 0.95 && std::abs(r1 - r0) <= 0.02 * r1;
+  };
+  double rg, rd;
+  if (!steady(pc[it - 3], pc[it - 2], pc[it - 1], rg)) return;
+  if (dl.size() < 3 || !steady(dl[dl.size() - 3], dl[dl.size() - 2], dl[dl.size() - 1], rd)) return;
+  if (std::abs(rg - rd) > 0.05 * rg) return;
+  const double f = rg / (1.0 - rg);
   for (std::size_t n = 0; n < source.size(); ++n) source[n] += f * (source[n] - source_prev[n]);
   for (std::size_t k = 0; k < g.size(); ++k) g[k] += f * (g[k] - g_prev[k]);
   last_extrapolation = it;
@@ -298,6 +312,7 @@ void LdcSolver::Impl::run() {
   }
   g_new.assign(nd, 0.0);
   last_extrapolation = 0;
+  aitken_off = false;
   setup_geometry();
   // Defect entries outside the new defect region (from a previous geometry) are dropped.
   std::vector<char> in_defect(grid.size(), 0);
