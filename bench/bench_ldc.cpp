@@ -1,6 +1,7 @@
 // LDC electrostatic solver benchmark (one figure: time per warm-started solve vs. discs and grid).
 //
 //   build/bench/bench_ldc [--quick]
+//   build/bench/bench_ldc --case DISCS CELLS RESOLVES [BOX_SIDE_M]   (one row)
 //
 // Setup: square box L = 1 mm, u = 0 at the bottom, 500 V at the top, Neumann sides; discs of
 // radius 5 µm and charge 1e-10 C/m at random non-overlapping positions (centre distance
@@ -10,6 +11,7 @@
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <cstdio>
 #include <cstdlib>
@@ -31,7 +33,8 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // the same run varies by 2-3x with the load of other jobs; CPU time varies much less.
 double cpu_seconds() { return double(std::clock()) / CLOCKS_PER_SEC; }
 
-constexpr double kL = 1e-3, kR = 5e-6, kQ = 1e-10;
+constexpr double kR = 5e-6, kQ = 1e-10;
+double kL = 1e-3;  // box side [m]; the constant-density scan enlarges it
 
 Params box_params(int cells) {
   Params p;
@@ -148,7 +151,8 @@ const char* kColumns = "analytic/schwarz/fd  unconverged  fd clusters/kept/LU pe
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 5 && std::strcmp(argv[1], "--case") == 0) {  // --case DISCS CELLS RESOLVES
+  if (argc == 6 && std::strcmp(argv[1], "--case") == 0) kL = std::atof(argv[5]);  // --case ... BOX_M
+  if (argc >= 5 && std::strcmp(argv[1], "--case") == 0) {  // --case DISCS CELLS RESOLVES [BOX_M]
     std::setvbuf(stdout, nullptr, _IOLBF, 0);
     const Result r = run(std::atoi(argv[2]), std::atoi(argv[3]), std::atoi(argv[4]), 42);
     std::printf(kHeader, "discs", "cold [ms]", "its", "warm [ms]", "cpu [ms]", "its", kColumns);
@@ -170,12 +174,24 @@ int main(int argc, char** argv) {
                 1e3 * r.cold_s, r.cold_iterations, 1e3 * r.warm_s, 1e3 * r.warm_cpu_s, r.warm_iterations, resolves, r.analytic, r.schwarz,
                 r.fd, r.unconverged);
   }
-  std::printf("\nTime per solve vs number of discs (coarse grid 100x100, H = 2R; 20 warm re-solves, 5 for 200):\n");
+  std::printf("\nTime per solve vs number of discs (coarse grid 100x100, H = 2R; 20 warm re-solves, 5 for 200 and 400):\n");
   std::printf(kHeader, "discs", "cold [ms]", "its", "warm [ms]", "cpu [ms]", "its", kColumns);
   for (int n : {25, 50, 100, 200, 400}) {
     const Result r = run(n, 100, quick ? 3 : (n > 100 ? 5 : 20), 42);
     print_row(std::to_string(n).c_str(), r);
   }
+  // Same density (100 discs per mm², H = 2R) in a growing box: the algorithmic scaling, without
+  // the denser packing (more Schwarz groups and finite-difference clusters) of the scan above.
+  std::printf("\nTime per solve vs number of discs at constant density (100 per mm^2, box side sqrt(N/100) mm, "
+              "H = 2R; 10 warm re-solves):\n");
+  std::printf(kHeader, "discs", "cold [ms]", "its", "warm [ms]", "cpu [ms]", "its", kColumns);
+  for (int n : {25, 100, 400, 1600}) {
+    const int cells = int(std::lround(100.0 * std::sqrt(n / 100.0)));
+    kL = 1e-3 * cells / 100.0;
+    const Result r = run(n, cells, quick ? 3 : 10, 42);
+    print_row(std::to_string(n).c_str(), r);
+  }
+  kL = 1e-3;
   std::printf("\nTime per solve vs coarse grid (100 discs, 10 warm re-solves):\n");
   std::printf(kHeader, "grid", "cold [ms]", "its", "warm [ms]", "cpu [ms]", "its", kColumns);
   for (int cells : {50, 100, 200, 400}) {
