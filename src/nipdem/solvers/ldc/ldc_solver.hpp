@@ -32,6 +32,10 @@ struct SolveStats {
   std::vector<double> delta;         // δ_i = max change of u^H on Γ between coarse solves i and i+1
   std::vector<double> potential_change;  // max_k |g_k,i - g_k,i-1|
   int schwarz_sweeps = 0;            // total over the solve
+  int fd_groups = 0;                 // finite-difference local problems in this solve
+  int fd_kept = 0;                   // ... that kept their matrix factorisation from the previous solve
+  int fd_factorisations = 0;         // LU factorisations of finite-difference matrices during this solve
+  int extrapolations = 0;            // Aitken steps (Params::aitken)
 };
 
 class LdcSolver {

@@ -15,7 +15,11 @@
 //  * Rectangle sides: Dirichlet values from `boundary` (interpolated coarse solution), or Neumann
 //    (mirror) where the rectangle lies on a Neumann side of the box.
 // The matrix depends only on the geometry, so it is LU-factorised once; each LDC iteration only
-// rebuilds the right-hand side.
+// rebuilds the right-hand side. When the conductors move a little between two LDC solves
+// (`update_conductors`), the matrix is rebuilt but the old factorisation is kept as long as no
+// node changes its kind: it then serves as the preconditioner of the iterative refinement with
+// the new matrix, which converges to the same round-off level as a fresh factorisation (checked
+// on every solve by the componentwise backward error; otherwise the matrix is re-factorised).
 #pragma once
 #include <array>
 #include <functional>
@@ -53,6 +57,18 @@ class FdLocalProblem {
   // Solves with the Dirichlet data u = boundary(x) on the non-Neumann sides.
   void solve(const std::function<double(Vec2)>& boundary);
 
+  // Moves / resizes / recharges the conductors (same number and kinds, same rectangle). Rebuilds
+  // the matrix; re-factorises only if a node changed its kind (inside / outside a conductor) or
+  // if the kept factorisation no longer brings the refinement to round-off within a few steps.
+  // Returns true if the previous factorisation was kept.
+  bool update_conductors(std::vector<FdConductor> conductors);
+  // Counters since construction: LU factorisations, solves done with a factorisation of an
+  // earlier matrix (stale), and iterative-refinement steps.
+  struct Counters { int factorisations = 0, stale_solves = 0, refinement_steps = 0; };
+  const Counters& counters() const { return counters_; }
+  // Componentwise backward error max_i |b - A x|_i / (|A| |x| + |b|)_i of the last solve.
+  double backward_error() const { return backward_error_; }
+
   int nx() const { return nx_; }
   int ny() const { return ny_; }
   Vec2 node(int i, int j) const { return {lo_.x + i * hx_, lo_.y + j * hy_}; }
@@ -82,6 +98,17 @@ class FdLocalProblem {
   std::vector<double> flux_radius_;  // circle carrying the charge condition, per conductor
   struct Coupling { int row, node; double coef; };
   std::vector<Coupling> couplings_;  // rhs[row] -= coef * u[node] for Dirichlet nodes
+  Counters counters_;
+  double backward_error_ = 0.0;
+  double fresh_backward_error_ = 0.0;  // reached by the last fresh factorisation
+  bool stale_ = false;                 // factorisation belongs to an earlier matrix
+  bool have_solution_ = false;         // impl_->x holds the previous solution (initial guess)
+  void assemble();                     // kind_, unknown_, couplings_, flux_radius_, matrix
+  void factorize();
+  // Iterative refinement of impl_->x for impl_->rhs with the current matrix until the backward
+  // error is at round-off or while the residual falls by the factor min_reduction per step (at
+  // most max_steps); sets backward_error_. Returns the steps.
+  int refine(int max_steps, double min_reduction);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

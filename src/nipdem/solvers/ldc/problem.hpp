@@ -63,6 +63,9 @@ struct Params {
   // between two iterations is below tolerance * (potential scale of the problem).
   double tolerance = 1e-8;
   int max_iterations = 200;
+  // Aitken extrapolation of the LDC iteration when it converges with a steady factor (dense
+  // configurations, docs/ldc.md). Off reproduces the plain iteration of §3.2.
+  bool aitken = true;
   int schwarz_max_iterations = 500;
   double schwarz_tolerance = 1e-12;  // relative to the potential scale
   double initial_potential_V = 0.0;   // u_guess of eq. 3.2.2 for a cold start

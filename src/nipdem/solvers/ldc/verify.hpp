@@ -39,7 +39,25 @@ double effective_outer_radius();
 // Table 3.4: Schwarz process for discs at (0.41,0.5) and (0.59,0.5), R11 = R21 = 0.05,
 // R12 = R22 = 0.1, q1 = 2, q2 = 1, u = 0 on the outer parts of Γ. ν_i and τ_i = ν_i/ν_{i-1}.
 struct Table34Row { int i; double nu; std::optional<double> tau; };
-std::vector<Table34Row> table_3_4(int rows = 10);
+// `samples` = 2N+1 points per Γ (the thesis does not say how many it used; docs/ldc.md).
+std::vector<Table34Row> table_3_4(int rows = 10, int samples = 2049);
+// Asymptotic factor of the same process: ratio of successive max-norm errors after `sweeps`
+// sweeps of the homogeneous error iteration (q = 0, zero outer data, error 1 on Γ*_1 initially).
+double schwarz_rate(int samples, int sweeps = 30);
+
+// Independent estimate of the asymptotic Schwarz factor of Table 3.4's geometry, without the
+// trigonometric interpolation: the error map e2|Γ*1 -> e1|Γ*2 -> e2|Γ*1 (eqs. 3.9.7-3.9.8) is an
+// integral operator T with the positive kernel of the annulus with a floating, uncharged inner
+// disc (closed form below), discretised by the midpoint rule on `nodes` points per arc. For a
+// positive operator, min_x (Tf)(x)/f(x) <= ρ(T) <= max_x (Tf)(x)/f(x) for every positive f
+// (Collatz-Wielandt); with f = T1 this brackets the spectral radius, i.e. the asymptotic
+// contraction of any error of one sign. The ratio is taken over the inner 80 % of Γ*1 (the
+// midpoint rule is inaccurate within a few nodes of the points where the two circles cross);
+// at the crossing points themselves the ratio tends to corner_limit = (1 - α/π)², α the angle of
+// the overlap lens there (local half-plane analysis). `lower` is the reliable number (converged
+// in n); `upper` misses the neighbourhood of the crossing points and is only indicative.
+struct SchwarzBounds { double lower, upper, corner_limit; };
+SchwarzBounds schwarz_rate_bounds(int nodes = 1600);
 
 // Fig. 3.6: problem 3.10.7 (unit square, u = 0 on the boundary, discs at (0.4,0.5) and (0.6,0.5),
 // R = 0.05, q1 = q2 = 1) by finite differences with h = 1/cells and the flux condition 3.10.6.
