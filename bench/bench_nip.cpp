@@ -41,6 +41,8 @@ struct Result {
   double wall_s = 0, cpu_s = 0, sim_s = 0, dt = 0, rate = 0, contacts_per_disc = 0;
   double z_disc = 0, z_body = 0;  // coordination numbers (toner-toner contacts counted at both ends)
   double magnet_s = 0;            // wall time inside the magnet provider during the timed steps
+  int dipole_builds = 0;          // dipole pair-list builds during the timed steps
+  std::size_t dipole_pairs = 0;   // listed dipole pairs (r < r_c + skin) at the end
   int builds = 0;
   long maxrss_kb = 0;
 };
@@ -294,12 +296,15 @@ State make_dense_state(const std::vector<std::string>& base, double press_time, 
   return snapshot(sim);
 }
 
+double g_dipole_skin = -1;  // --dipole-skin: MagnetConfig::dipole_skin (not a config key)
+
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
   if (start) overrides.push_back("inflow.prefill=false");
   auto cfg = experiments::parse_nip_config(experiments::preset_text("black"), "preset:black", overrides);
   // The magnet's per-particle loop runs on the engine's threads (MagnetConfig::threads is not
   // a config key; the nip should set it from run.threads the same way).
   cfg.magnet.threads = cfg.threads;
+  if (g_dipole_skin >= 0) cfg.magnet.dipole_skin = g_dipole_skin;
   // The magnet provider is added here (as NipRun would, it is the only provider) so that it
   // can be timed.
   const auto magnet_cfg = cfg.magnet;
@@ -307,8 +312,10 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   experiments::NipRun nip(cfg);
   auto& sim = nip.sim();
   std::shared_ptr<TimedForce> timed;
+  std::shared_ptr<experiments::MagnetForce> mf;
   if (auto field = experiments::make_magnet_field(magnet_cfg)) {
-    timed = std::make_shared<TimedForce>(std::make_shared<experiments::MagnetForce>(field, magnet_cfg));
+    mf = std::make_shared<experiments::MagnetForce>(field, magnet_cfg);
+    timed = std::make_shared<TimedForce>(mf);
     sim.add_force(timed);
   }
   const double dt = nip.time_step().dt;
@@ -347,12 +354,17 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   const double s0 = sim.time();
   const int builds0 = sim.neighbor_list().builds();
   if (timed) timed->seconds = 0.0;
+  const int dbuilds0 = mf ? mf->dipole_pairs().builds() : 0;
   nip.advance_to(s0 + steps * dt);
   r.builds = sim.neighbor_list().builds() - builds0;
   const auto t1 = std::chrono::steady_clock::now();
   r.cpu_s = cpu_seconds() - c0;
   r.wall_s = std::chrono::duration<double>(t1 - t0).count();
   r.magnet_s = timed ? timed->seconds : 0.0;
+  if (mf) {
+    r.dipole_builds = mf->dipole_pairs().builds() - dbuilds0;
+    r.dipole_pairs = mf->dipole_pairs().listed_pairs();
+  }
   r.sim_s = sim.time() - s0;
   r.discs = (d0 + sim.discs().x.size()) / 2;  // average over the timed phase (inflow/outflow)
   r.rate = static_cast<double>(r.discs) * static_cast<double>(steps) / r.wall_s;
@@ -366,9 +378,9 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
 void print(const char* label, const Result& r, long steps) {
   std::printf("  %-28s particles=%zu discs=%zu wall=%.3f s cpu=%.3f s disc_steps_per_s=%.4g "
               "wall_per_simulated_ms=%.2f s contacts_per_disc=%.3f coordination_disc=%.2f coordination_body=%.2f list_builds=%d "
-              "peak_rss=%.1f MB magnet_share=%.1f %%\n",
+              "peak_rss=%.1f MB magnet_share=%.1f %% dipole_list_builds=%d dipole_listed_pairs=%zu\n",
               label, r.bodies, r.discs, r.wall_s, r.cpu_s, r.rate, r.wall_s / (r.sim_s * 1e3), r.contacts_per_disc, r.z_disc, r.z_body,
-              r.builds, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s);
+              r.builds, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s, r.dipole_builds, r.dipole_pairs);
   (void)steps;
 }
 
@@ -410,6 +422,7 @@ int main(int argc, char** argv) {
     else if (k == "--dense-file") dense_file = val();
     else if (k == "--press-time") press_time = std::stod(val());
     else if (k == "--relax-steps") relax_steps = std::stol(val());
+    else if (k == "--dipole-skin") g_dipole_skin = std::stod(val());
     else if (k == "--repeat") repeat = std::max(1, std::stoi(val()));
     else if (k == "--set") extra.push_back(val());
     else {
