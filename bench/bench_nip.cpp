@@ -5,12 +5,16 @@
 // reports disc-steps/s, wall time per simulated ms, peak memory and the magnet's cost.
 //
 // Starting states (--state):
-//   dense (default): the prefilled layer compacted and settled before timing (untimed, see
-//       make_dense_state): 2-4 contacts per disc, like the assembly of a running nip.
+//   dense (default): the prefilled layer pressed onto the roller and settled before timing
+//       (untimed, see make_dense_state): held by the knife, toner-toner coordination ~0.6 per
+//       disc and ~1.3 per tri3 particle (measured at half-width 6.3 mm).
 //   loose: the prefilled layer as inserted (area fraction 0.5, ~0 contacts): the old benchmark.
+// On the dense state the fair magnet cost is its share inside the magnet run (stopwatch around
+// the provider): without the magnet that assembly falls apart (bench/README.md).
 //
 // Usage: bench_nip [--steps N=2000] [--settle N] [--threads T=1] [--half-width M=4.2e-3]
 //                  [--state dense|loose] [--dense-file FILE] [--repeat R=1]
+//                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M=2e-6]
 //                  [--set key=value ...]   (extra config overrides, as `nipdem run --set`)
 #include <algorithm>
 #include <chrono>
@@ -427,7 +431,8 @@ int main(int argc, char** argv) {
     else if (k == "--set") extra.push_back(val());
     else {
       std::fprintf(stderr, "usage: bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] "
-                           "[--dense-file FILE] [--repeat R] [--set key=value]\n");
+                           "[--dense-file FILE] [--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] "
+                           "[--set key=value]\n");
       return 2;
     }
   }

@@ -40,7 +40,8 @@ struct MagnetConfig {
 // position, never on when it was built, so results stay deterministic and resume-exact.
 // Optionally the dipole-dipole force between the induced moments within a cut-off, with the
 // moments induced by the magnet's field only (§4.5); it is re-evaluated every
-// `dipole_interval` steps and held in between (multiple time stepping; docs/magnetic.md).
+// `dipole_interval` steps and held in between (multiple time stepping; docs/magnetic.md),
+// summed over a persistent pair list (dipole::PairSum: exact cut-off sum, rebuilt after load).
 class MagnetForce final : public engine::BodyForce {
  public:
   MagnetForce(std::shared_ptr<const magnet::MagnetField> field, MagnetConfig cfg);
