@@ -11,6 +11,7 @@
 #include "nipdem/models/electric_force.hpp"
 #include "nipdem/models/rc_charge.hpp"
 #include "nipdem/solvers/conduction_path.hpp"
+#include "nipdem/models/dipole.hpp"
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
@@ -23,6 +24,8 @@ struct MagnetConfig {
   bool dipole_dipole = true;
   double dipole_cutoff = 42e-6;    // [m]: 8 R50 (docs/magnetic.md: ~1.3 % mean truncation error)
   int dipole_interval = 10;        // steps between dipole-dipole re-evaluations
+  double dipole_skin = 2e-6;       // [m] reach of the persistent dipole pair list beyond the
+                                   // cut-off (saves the search only: the sum is exact within it)
   int field_interval = 10;         // steps between magnet-field force re-evaluations: a toner moves
                                    // < 0.1 um in 10 steps, the field varies over >= 100 um
   int threads = 1;                 // OpenMP threads for the per-particle field force (set it to
@@ -37,7 +40,8 @@ struct MagnetConfig {
 // position, never on when it was built, so results stay deterministic and resume-exact.
 // Optionally the dipole-dipole force between the induced moments within a cut-off, with the
 // moments induced by the magnet's field only (§4.5); it is re-evaluated every
-// `dipole_interval` steps and held in between (multiple time stepping; docs/magnetic.md).
+// `dipole_interval` steps and held in between (multiple time stepping; docs/magnetic.md),
+// summed over a persistent pair list (dipole::PairSum: exact cut-off sum, rebuilt after load).
 class MagnetForce final : public engine::BodyForce {
  public:
   MagnetForce(std::shared_ptr<const magnet::MagnetField> field, MagnetConfig cfg);
@@ -47,11 +51,14 @@ class MagnetForce final : public engine::BodyForce {
   // Dipole-dipole part of the last evaluation, per body [N] (for tests and output).
   const std::vector<double>& dipole_fx() const { return dfx_; }
   const std::vector<double>& dipole_fy() const { return dfy_; }
+  // Induced moments of the last field evaluation, per body [A m^2].
+  const std::vector<Vec2>& moments() const { return moment_; }
+  const dipole::PairSum& dipole_pairs() const { return pairs_; }
   void save(std::ostream& o) const override;
   void load(std::istream& in) override;
 
  private:
-  void dipole_pass(const BodyStore& b);
+  void dipole_pass(const BodyStore& b, bool same_set);
   void field_pass(const BodyStore& b);
   magnet::Sample field_at(Vec2 p);
   const magnet::MagnetField* tile_for(Vec2 p);  // builds the tile if needed; null = use field_
@@ -68,8 +75,7 @@ class MagnetForce final : public engine::BodyForce {
   std::vector<std::int64_t> ids_;         // body ids the held forces belong to
   std::vector<double> ffx_, ffy_;         // held magnet-field force per body [N]
   long calls_ = 0;
-  // cell list scratch
-  std::vector<int> head_, next_;
+  dipole::PairSum pairs_;                 // persistent pair list (not saved: rebuilt after load)
 };
 
 struct ElectricConfig {

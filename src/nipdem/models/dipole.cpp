@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <omp.h>
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
@@ -118,6 +119,166 @@ std::vector<Vec2> random_dense_packing(double R, double phi, double L, std::uint
     if (worst < 0.01 * R) break;
   }
   return p;
+}
+
+// ---- PairSum --------------------------------------------------------------------------------
+
+PairSum::PairSum(PairSumParams p) : p_(p) {
+  require_positive("dipole.pair_sum", "cutoff_m", p_.cutoff_m);
+  require_range("dipole.pair_sum", "skin_m", p_.skin_m, 0.0, p_.cutoff_m);
+  if (p_.threads < 1) throw_input("dipole.pair_sum", "threads", fmt::format("{}", p_.threads), "must be >= 1", ">= 1");
+}
+
+bool PairSum::moved(std::span<const double> x, std::span<const double> y) const {
+  // Rebuild once any particle moved more than skin/2 (a little less, so that rounding in
+  // this test can never let a pair closer than r_c be missing from the list).
+  const double lim = 0.49 * p_.skin_m, lim2 = lim * lim;
+  const std::size_t n = x.size();
+  bool any = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - x0_[i], dy = y[i] - y0_[i];
+    any |= !(dx * dx + dy * dy <= lim2);  // NaN counts as moved
+  }
+  return any;
+}
+
+void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
+  const std::size_t n = x.size();
+  const double reach = p_.cutoff_m + p_.skin_m, reach2 = reach * reach;
+  double xmin = 0, xmax = 0, ymin = 0, ymax = 0;
+  bool first = true;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;
+    if (first) { xmin = xmax = x[i]; ymin = ymax = y[i]; first = false; }
+    xmin = std::min(xmin, x[i]); xmax = std::max(xmax, x[i]);
+    ymin = std::min(ymin, y[i]); ymax = std::max(ymax, y[i]);
+  }
+  // Cells at least `reach` wide; coarser if a stray particle would make the grid huge.
+  double cs = reach;
+  auto count = [&](double c) { return (std::floor((xmax - xmin) / c) + 1.0) * (std::floor((ymax - ymin) / c) + 1.0); };
+  while (count(cs) > 4.0 * static_cast<double>(n) + 64.0) cs *= 2.0;
+  const int nx = static_cast<int>((xmax - xmin) / cs) + 1, ny = static_cast<int>((ymax - ymin) / cs) + 1;
+  head_.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), -1);
+  next_.assign(n, -1);
+  std::vector<int> cell(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i])) continue;  // such a particle gets no partners
+    const int cx = std::min(nx - 1, static_cast<int>((x[i] - xmin) / cs));
+    const int cy = std::min(ny - 1, static_cast<int>((y[i] - ymin) / cs));
+    cell[i] = cy * nx + cx;
+    next_[i] = head_[static_cast<std::size_t>(cell[i])];
+    head_[static_cast<std::size_t>(cell[i])] = static_cast<int>(i);
+  }
+  row_start_.assign(n + 1, 0);
+  nbr_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    row_start_[i] = static_cast<int>(nbr_.size());
+    if (cell[i] < 0) continue;
+    const int cx = cell[i] % nx, cy = cell[i] / nx;
+    const int ii = static_cast<int>(i);
+    cand_.clear();
+    for (int oy = std::max(0, cy - 1); oy <= std::min(ny - 1, cy + 1); ++oy)
+      for (int ox = std::max(0, cx - 1); ox <= std::min(nx - 1, cx + 1); ++ox)
+        for (int j = head_[static_cast<std::size_t>(oy * nx + ox)]; j >= 0; j = next_[static_cast<std::size_t>(j)]) {
+          if (j == ii) continue;
+          // owner of the pair (a < b): a if a + b is even, else b
+          const int a = std::min(ii, j), bb = std::max(ii, j);
+          if ((((a + bb) & 1) == 0 ? a : bb) != ii) continue;
+          const double dx = x[i] - x[static_cast<std::size_t>(j)], dy = y[i] - y[static_cast<std::size_t>(j)];
+          if (dx * dx + dy * dy < reach2) cand_.push_back(j);
+        }
+    std::sort(cand_.begin(), cand_.end());
+    nbr_.insert(nbr_.end(), cand_.begin(), cand_.end());
+  }
+  row_start_[n] = static_cast<int>(nbr_.size());
+  x0_.assign(x.begin(), x.end());
+  y0_.assign(y.begin(), y.end());
+  built_n_ = static_cast<long>(n);
+  ++builds_;
+}
+
+void PairSum::compute(std::span<const double> x, std::span<const double> y, std::span<const Vec2> m, bool same_set,
+                      std::vector<double>& fx, std::vector<double>& fy) {
+  const std::size_t n = x.size();
+  fx.assign(n, 0.0);
+  fy.assign(n, 0.0);
+  if (n < 2) return;
+  if (!same_set || built_n_ != static_cast<long>(n) || moved(x, y)) rebuild(x, y);
+  pk_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) pk_[i] = {x[i], y[i], m[i].x, m[i].y};
+  const int nt = p_.threads;
+  buf_.resize(static_cast<std::size_t>(nt));
+  const double rc2 = p_.cutoff_m * p_.cutoff_m;
+  const double k3 = 3.0 * k_mu0_4pi;
+  const Packed* pk = pk_.data();
+  const int* rs = row_start_.data();
+  const int* nb = nbr_.data();
+#pragma omp parallel num_threads(nt)
+  {
+    const int t = omp_get_thread_num();
+    auto& bv = buf_[static_cast<std::size_t>(t)];
+    bv.assign(2 * n, 0.0);
+    double* f = bv.data();
+    // rows split by index, so the summation order does not depend on the list content
+    const std::size_t i0 = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
+    const std::size_t i1 = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(nt);
+    for (std::size_t i = i0; i < i1; ++i) {
+      const Packed pi = pk[i];
+      double fxi = 0.0, fyi = 0.0;
+      for (int e = rs[i]; e < rs[i + 1]; ++e) {
+        const int j = nb[e];
+        const Packed pj = pk[j];
+        const double dx = pi.x - pj.x, dy = pi.y - pj.y;
+        const double r2 = dx * dx + dy * dy;
+        if (!(r2 < rc2)) continue;
+        // eq. 2.4.39 with e = r/|r|: F_i = 3k/r^5 [a m_j + b m_i + (c - 5 a b / r^2) r],
+        // a = m_i.r, b = m_j.r, c = m_i.m_j (the same law as dipole_force, one sqrt, one division)
+        const double ir2 = 1.0 / r2;
+        const double ir = std::sqrt(ir2);
+        const double a = pi.mx * dx + pi.my * dy;
+        const double b = pj.mx * dx + pj.my * dy;
+        const double c = pi.mx * pj.mx + pi.my * pj.my;
+        const double pre = k3 * ir2 * ir2 * ir;
+        const double s = c - 5.0 * a * b * ir2;
+        const double gx = pre * (a * pj.mx + b * pi.mx + s * dx);
+        const double gy = pre * (a * pj.my + b * pi.my + s * dy);
+        fxi += gx;
+        fyi += gy;
+        f[2 * j] -= gx;
+        f[2 * j + 1] -= gy;
+      }
+      f[2 * i] += fxi;
+      f[2 * i + 1] += fyi;
+    }
+#pragma omp barrier
+#pragma omp for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      double sx = 0.0, sy = 0.0;
+      for (int q = 0; q < nt; ++q) {  // fixed thread order: reproducible for a given thread count
+        sx += buf_[static_cast<std::size_t>(q)][2 * i];
+        sy += buf_[static_cast<std::size_t>(q)][2 * i + 1];
+      }
+      fx[i] = sx;
+      fy[i] = sy;
+    }
+  }
+}
+
+void brute_force_pair_sum(std::span<const double> x, std::span<const double> y, std::span<const Vec2> m, double cutoff_m,
+                          std::vector<double>& fx, std::vector<double>& fy) {
+  const std::size_t n = x.size();
+  fx.assign(n, 0.0);
+  fy.assign(n, 0.0);
+  const double rc2 = cutoff_m * cutoff_m;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i) continue;
+      const Vec2 r{x[i] - x[j], y[i] - y[j]};
+      if (!(norm2(r) < rc2)) continue;
+      const Vec2 f = dipole_force(m[i], m[j], r);
+      fx[i] += f.x;
+      fy[i] += f.y;
+    }
 }
 
 std::vector<TruncationStats> measure_cutoff_truncation(const TruncationSetup& s, const std::vector<double>& cutoffs) {
