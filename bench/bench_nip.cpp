@@ -27,6 +27,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_args.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip.hpp"
 #include "nipdem/experiments/nip_config.hpp"
@@ -412,30 +413,20 @@ int main(int argc, char** argv) {
   long relax_steps = 4000;
   std::string half_width = "4.2e-3", state = "dense", dense_file;
   std::vector<std::string> extra;
-  for (int a = 1; a < argc; ++a) {
-    const std::string k = argv[a];
-    auto val = [&]() -> std::string {
-      if (a + 1 >= argc) { std::fprintf(stderr, "missing value for %s\n", k.c_str()); std::exit(2); }
-      return argv[++a];
-    };
-    if (k == "--steps") steps = std::stol(val());
-    else if (k == "--settle") settle = std::stol(val());
-    else if (k == "--threads") threads = std::stoi(val());
-    else if (k == "--half-width") half_width = val();
-    else if (k == "--state") state = val();
-    else if (k == "--dense-file") dense_file = val();
-    else if (k == "--press-time") press_time = std::stod(val());
-    else if (k == "--relax-steps") relax_steps = std::stol(val());
-    else if (k == "--dipole-skin") g_dipole_skin = std::stod(val());
-    else if (k == "--repeat") repeat = std::max(1, std::stoi(val()));
-    else if (k == "--set") extra.push_back(val());
-    else {
-      std::fprintf(stderr, "usage: bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] "
-                           "[--dense-file FILE] [--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] "
-                           "[--set key=value]\n");
-      return 2;
-    }
-  }
+  bench::parse_args(argc, argv,
+                    "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
+                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--set key=value]",
+                    {{"--steps", [&](const std::string& v) { steps = std::stol(v); }},
+                     {"--settle", [&](const std::string& v) { settle = std::stol(v); }},
+                     {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
+                     {"--half-width", [&](const std::string& v) { half_width = v; }},
+                     {"--state", [&](const std::string& v) { state = v; }},
+                     {"--dense-file", [&](const std::string& v) { dense_file = v; }},
+                     {"--press-time", [&](const std::string& v) { press_time = std::stod(v); }},
+                     {"--relax-steps", [&](const std::string& v) { relax_steps = std::stol(v); }},
+                     {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = std::stod(v); }},
+                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, std::stoi(v)); }},
+                     {"--set", [&](const std::string& v) { extra.push_back(v); }}});
   if (state != "dense" && state != "loose") {
     std::fprintf(stderr, "bench_nip: --state must be dense or loose\n");
     return 2;

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_args.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip.hpp"
 #include "nipdem/experiments/presets.hpp"
@@ -78,24 +79,14 @@ int main(int argc, char** argv) {
   int threads = 1, repeat = 3;
   double x0 = -250e-6, x1 = 450e-6;
   std::vector<std::string> extra;
-  for (int a = 1; a < argc; ++a) {
-    const std::string k = argv[a];
-    auto val = [&]() -> std::string {
-      if (a + 1 >= argc) { std::fprintf(stderr, "missing value for %s\n", k.c_str()); std::exit(2); }
-      return argv[++a];
-    };
-    if (k == "--steps") steps = std::stol(val());
-    else if (k == "--settle") settle = std::stol(val());
-    else if (k == "--threads") threads = std::stoi(val());
-    else if (k == "--repeat") repeat = std::max(1, std::stoi(val()));
-    else if (k == "--x0") x0 = std::stod(val());
-    else if (k == "--x1") x1 = std::stod(val());
-    else if (k == "--set") extra.push_back(val());
-    else {
-      std::fprintf(stderr, "usage: bench_print [--steps N] [--settle N] [--threads T] [--repeat R] [--x0 M] [--x1 M] [--set key=value]\n");
-      return 2;
-    }
-  }
+  bench::parse_args(argc, argv, "bench_print [--steps N] [--settle N] [--threads T] [--repeat R] [--x0 M] [--x1 M] [--set key=value]",
+                    {{"--steps", [&](const std::string& v) { steps = std::stol(v); }},
+                     {"--settle", [&](const std::string& v) { settle = std::stol(v); }},
+                     {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
+                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, std::stoi(v)); }},
+                     {"--x0", [&](const std::string& v) { x0 = std::stod(v); }},
+                     {"--x1", [&](const std::string& v) { x1 = std::stod(v); }},
+                     {"--set", [&](const std::string& v) { extra.push_back(v); }}});
   std::vector<std::string> base = {
       "geometry.window_x_min_m=-300e-6", "geometry.window_x_max_m=700e-6", "inflow.layer_thickness_m=0",
       "inflow.prefill=false",            "inflow.roller_pits=\"filled\"",  "run.threads=" + std::to_string(threads),
