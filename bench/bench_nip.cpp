@@ -440,6 +440,9 @@ int main(int argc, char** argv) {
       "geometry.window_x_min_m=-" + half_width, "geometry.window_x_max_m=" + half_width,
       "inflow.layer_thickness_m=140e-6",       "inflow.area_fraction=0.5",
       "run.threads=" + std::to_string(threads), "output.vtk=false",
+      // the pressed layer fills the pits itself; pits arriving filled (the preset's default since
+      // 2026-11-23 17:00) would add toner on top of a saved dense state
+      "inflow.roller_pits=\"empty\"",
   };
   base.insert(base.end(), extra.begin(), extra.end());
   std::printf("bench_nip git=%s preset=black state=%s steps=%ld settle=%ld threads=%d repeat=%d load_average=%.2f\n", kGitHash,

@@ -29,6 +29,7 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
     throw_input("engine", "periodic_x", "", "x_hi must exceed x_lo for a periodic box");
   for (auto& w : walls_) {
     w.validate();
+    w.prepare();
     if (w.interaction < 0 || w.interaction >= static_cast<int>(params_.interactions.size()))
       throw_input("wall '" + w.name + "'", "interaction", std::to_string(w.interaction), "no such interaction");
   }

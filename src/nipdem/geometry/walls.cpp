@@ -61,9 +61,24 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   // by its segments and vertices (each costs a sin and a cos). Scratch grows once per thread.
   thread_local std::vector<Vec2> pts;
   if (pts.size() < profile.size()) pts.resize(profile.size());
+  const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P;
+  Vec2 u{};  // (cos, sin) of the polar angle of period k's s = 0
   for (int dk = -1; dk <= 1; ++dk) {
     const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
-    for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
+    if (fast) {
+      if (dk == -1) {
+        const double base = (k * P + phase) / radius + angle;
+        u = {std::cos(base), std::sin(base)};
+      } else {
+        u = {u.x * period_rotation_.x - u.y * period_rotation_.y, u.x * period_rotation_.y + u.y * period_rotation_.x};
+      }
+      for (int j = 0; j <= m; ++j) {
+        const Vec2 e{u.x * unit_offsets_[j].x - u.y * unit_offsets_[j].y, u.x * unit_offsets_[j].y + u.y * unit_offsets_[j].x};
+        pts[j] = centre + (radius - profile[j].y) * e;
+      }
+    } else {
+      for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
+    }
     for (int j = 0; j < m; ++j) {
       const Vec2 a = pts[j];
       const Vec2 b = pts[j + 1];
@@ -92,6 +107,15 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, dq / dd, gap, cross(omega, v - centre)});
     }
   }
+}
+
+void Wall::prepare() {
+  unit_offsets_.clear();
+  if (kind != Kind::cylinder || !rough() || !(radius > 0.0)) return;
+  for (const auto& v : profile) unit_offsets_.push_back({std::cos(v.x / radius), std::sin(v.x / radius)});
+  period_rotation_ = {std::cos(period() / radius), std::sin(period() / radius)};
+  prepared_radius_ = radius;
+  prepared_period_ = period();
 }
 
 double Wall::surface_radius(Vec2 p) const {
@@ -139,6 +163,7 @@ void set_pyramid_roughness(Wall& w, double height, double base, double spacing) 
   const double scale = circumference / (w.n_periods * nominal);  // stretch to fit exactly
   const double L = spacing * scale, B = base * scale;
   w.profile = {{0.0, 0.0}, {L, 0.0}, {L + 0.5 * B, height}, {L + B, 0.0}};
+  w.prepare();
 }
 
 }  // namespace nipdem::geometry

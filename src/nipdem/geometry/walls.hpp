@@ -66,6 +66,13 @@ struct Wall {
     const double a = radius + r + reach;  // features lie at depth >= 0 inside the base circle
     return d2 <= a * a * (1.0 + kSlack);
   }
+  // Precomputes the rotations query() needs on a rough cylinder (one sin/cos per query instead
+  // of one per profile vertex). Called by set_pyramid_roughness and the engine; query() falls
+  // back to direct trigonometry when the cache is missing or stale (radius or period changed).
+  void prepare();
+  std::vector<Vec2> unit_offsets_;  // (cos, sin) of s_j / radius for each profile vertex
+  Vec2 period_rotation_{1.0, 0.0};  // (cos, sin) of period / radius
+  double prepared_radius_ = 0.0, prepared_period_ = 0.0;
   // Advances the prescribed motion by dt.
   void advance(double dt) { angle += omega * dt; }
   // Distance from the axis of the cylinder's surface in the direction of p (radius minus the
