@@ -36,7 +36,10 @@ TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
                      C{"experiment front-position --gap 150e-6 --sleeve-speed x", "--sleeve-speed"},
                      C{"experiment reduction --preset purple", "unknown preset"},
                      C{"experiment edge-sharpness --realizations 1", "--realizations"},
-                     C{"experiment front-position --set geometry.gap_mm=1", "geometry.gap_mm"}}) {
+                     C{"experiment front-position --set geometry.gap_mm=1", "geometry.gap_mm"},
+                     C{"experiment vo-level --line-start 5", "start_m"},
+                     C{"experiment edge-sharpness --line-start 5", "start_m"},
+                     C{"experiment edge-sharpness --extra-time -1", "--extra-time"}}) {
     SCOPED_TRACE(c.args);
     const auto r = cli(c.args + " --out " + d.string() + " --quiet");
     EXPECT_EQ(r.status, 2) << r.err;

@@ -235,7 +235,9 @@ PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double vo
 json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   require_range("experiment vo-level", "--step", v.step_V, 1e-3, 100.0);
   if (v.seeds < 1) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "need >= 1");
-  experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=0", "print.length_m=1e-4"});
+  // reject a bad configuration or line before any run starts (exit 2, not failed points)
+  experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=" + num(v.print.line_start_m),
+                        "print.length_m=" + num(v.print.line_length_m)});
   auto task = [&](std::size_t, std::uint64_t seed) {
     const auto res = analysis::find_vo_level([&](double V) { return print_line(o, v.print, V, seed).printed; },
                                              {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V});
