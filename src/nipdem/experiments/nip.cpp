@@ -117,12 +117,15 @@ bool NipRun::place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity,
   return true;
 }
 
-bool NipRun::try_insert(double x_lo, double x_hi) {
+NipRun::Draw NipRun::draw_toner() {
   const double d = cfg_.size.sample(rng_);
-  engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
-  const double angle = rng_.uniform(0.0, 2.0 * pi);
-  double extent = 0.0;
-  for (std::size_t k = 0; k < spec.radii.size(); ++k) extent = std::max(extent, norm(spec.offsets[k]) + spec.radii[k]);
+  Draw t{make_toner(*tmpl_, d, cfg_.density), rng_.uniform(0.0, 2.0 * pi), 0.0};
+  for (std::size_t k = 0; k < t.spec.radii.size(); ++k) t.extent = std::max(t.extent, norm(t.spec.offsets[k]) + t.spec.radii[k]);
+  return t;
+}
+
+bool NipRun::try_insert(double x_lo, double x_hi) {
+  auto [spec, angle, extent] = draw_toner();
   const double x = rng_.uniform(x_lo, x_hi);
   // within the layer under the drum surface, not touching it
   const double ytop = drum_surface_y(x) - extent - 1e-8;
@@ -135,11 +138,7 @@ bool NipRun::try_insert(double x_lo, double x_hi) {
 }
 
 bool NipRun::try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi) {
-  const double d = cfg_.size.sample(rng_);
-  engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
-  const double angle = rng_.uniform(0.0, 2.0 * pi);
-  double extent = 0.0;
-  for (std::size_t k = 0; k < spec.radii.size(); ++k) extent = std::max(extent, norm(spec.offsets[k]) + spec.radii[k]);
+  auto [spec, angle, extent] = draw_toner();
   const double x = rng_.uniform(x_lo, x_hi);
   const double ybot = roller_surface_y(x) + std::max(h_lo, 0.0) + extent + 1e-8;
   const double ytop = std::min(roller_surface_y(x) + h_hi - extent, drum_surface_y(x) - extent - 1e-8);
@@ -152,15 +151,13 @@ int NipRun::fill_pits(double x_lo, double x_hi, int max_failures) {
   const auto& roller = sim_->walls()[0];
   int n = 0, failures = 0;
   while (failures < max_failures) {
-    const double d = cfg_.size.sample(rng_);
-    engine::BodySpec spec = make_toner(*tmpl_, d, cfg_.density);
-    const double angle = rng_.uniform(0.0, 2.0 * pi);
+    Draw t = draw_toner();
     const double x = rng_.uniform(x_lo, x_hi);
     const double y0 = roller_surface_y(x);
     const Vec2 pos{x, rng_.uniform(y0 - cfg_.rough_height, y0)};
     // centre below the land level and in the open part of a pit; moving with the sleeve
     if (norm(pos - roller.centre) > roller.surface_radius(pos) &&
-        place(spec, pos, angle, cross(roller.omega, pos - roller.centre), roller.omega)) {
+        place(t.spec, pos, t.angle, cross(roller.omega, pos - roller.centre), roller.omega)) {
       ++n;
       failures = 0;
     } else {

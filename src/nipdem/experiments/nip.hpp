@@ -85,6 +85,10 @@ class NipRun {
   nlohmann::json describe() const;
 
  private:
+  // A toner drawn from the size distribution with a random orientation; extent = largest
+  // member reach from the centre of mass [m].
+  struct Draw { engine::BodySpec spec; double angle, extent; };
+  Draw draw_toner();
   bool try_insert(double x_lo, double x_hi);
   // Insert one particle at random in x [x_lo, x_hi], height [h_lo, h_hi] above the roller.
   bool try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi);
