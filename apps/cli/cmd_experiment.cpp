@@ -1,10 +1,12 @@
-// `nipdem experiment front-position|reduction|vo-level|edge-sharpness` (CLI.md).
+// `nipdem experiment front-position|reduction|vo-level|edge-sharpness` (CLI.md), and
+// `nipdem calibrate cohesion` (r fitted to a reduction speed over reduction experiments).
 #include <memory>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/experiments/calibrate_cohesion.hpp"
 #include "nipdem/experiments/ensemble.hpp"
 #include "nipdem/experiments/nip_experiments.hpp"
 #include "nipdem/io/atomic_file.hpp"
@@ -36,13 +38,13 @@ std::vector<double> parse_list(const std::string& text, const std::string& key) 
   return v;
 }
 
-void add_common(CLI::App* sub, const std::shared_ptr<Common>& c, const std::string& name) {
+void add_common(CLI::App* sub, const std::shared_ptr<Common>& c, const std::string& name, bool mpi = true) {
   sub->add_option("--preset", c->o.preset, "black or color")->capture_default_str();
   sub->add_option("--config", c->o.config, "a config file instead of a preset");
   sub->add_option("--set", c->o.sets, "override a config key for every run (repeatable)");
   sub->add_option("--seed", c->o.seed, "base seed (same seed, same result)")->capture_default_str();
   sub->add_option("--jobs", c->o.jobs, "threads running points/realizations in parallel")->capture_default_str()->check(CLI::Range(1, 256));
-  sub->add_flag("--mpi", c->o.mpi, "spread points over MPI ranks (under mpirun); results gathered on rank 0");
+  if (mpi) sub->add_flag("--mpi", c->o.mpi, "spread points over MPI ranks (under mpirun); results gathered on rank 0");
   sub->add_option("--out", c->out, "output folder (default runs/" + name + ")");
   sub->add_flag("--json", c->json, "print one JSON object on stdout");
   sub->add_flag("--quiet", c->quiet, "no progress on stderr");
@@ -59,6 +61,8 @@ void finish(const std::shared_ptr<Common>& c, const std::string& name, const std
   nipdem::io::write_file_atomic(c->o.out / (name + ".json"), j.dump(2));
   if (c->json) nipdem::cli::print_json(j.dump());
   else std::fprintf(stderr, "%s: results in %s\n", name.c_str(), c->o.out.c_str());
+  if (j.contains("bracketed") && !j["bracketed"].get<bool>())
+    throw std::runtime_error("the target was not bracketed (" + j.value("hint", std::string()) + "); see " + (c->o.out / (name + ".json")).string());
   if (j.value("n_failed", 0) > 0) throw std::runtime_error(std::to_string(j["n_failed"].get<int>()) + " point(s) failed; see \"failed\" in " + (c->o.out / (name + ".json")).string());
 }
 
@@ -121,6 +125,22 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--extra-time", e->print.extra_time_s, "run this long after the line's end has left the window [s] (printing goes on after the track is off)")->capture_default_str()->check(CLI::Range(0.0, 1.0));
     sub->add_option("--bootstrap", e->bootstrap, "bootstrap resamples")->capture_default_str();
     sub->callback([=] { finish(c, "edge-sharpness", [&] { return edge_sharpness(c->o, *e); }); });
+  }
+  {
+    auto c = std::make_shared<Common>();
+    auto k = std::make_shared<nipdem::calibrate::CohesionOptions>();
+    auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+    auto* sub = cal->add_subcommand("cohesion", "Fit r = F_coh/F_adh to a measured reduction speed (Table 4.3) over reduction runs (§4.6)");
+    add_common(sub, c, "cohesion", /*mpi=*/false);
+    sub->add_option("--target-speed", k->target_speed_m_per_s, "measured reduction speed [m/s] (Table 4.3: black 7.6e-4, colour 2.5e-4)")->required();
+    sub->add_option("--r-min", k->r_min, "lower end of the first r range")->capture_default_str();
+    sub->add_option("--r-max", k->r_max, "upper end of the first r range")->capture_default_str();
+    sub->add_option("--points", k->points, "reduction runs per round (log-spaced in r)")->capture_default_str();
+    sub->add_option("--rounds", k->rounds, "rounds: the first over [r-min, r-max], then inside the bracket")->capture_default_str();
+    sub->add_option("--time", k->reduction.time_s, "observation time per run [s] (thesis: 0.1)")->capture_default_str();
+    sub->add_option("--pile-width", k->reduction.pile_width_m, "initial assembly width [m]")->capture_default_str();
+    sub->add_option("--pile-height", k->reduction.pile_height_m, "initial assembly height [m]")->capture_default_str();
+    sub->callback([=] { finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion(c->o, *k); }); });
   }
 });
 }  // namespace

@@ -39,7 +39,10 @@ TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
                      C{"experiment front-position --set geometry.gap_mm=1", "geometry.gap_mm"},
                      C{"experiment vo-level --line-start 5", "start_m"},
                      C{"experiment edge-sharpness --line-start 5", "start_m"},
-                     C{"experiment edge-sharpness --extra-time -1", "--extra-time"}}) {
+                     C{"experiment edge-sharpness --extra-time -1", "--extra-time"},
+                     C{"calibrate cohesion --target-speed 7.6e-4 --r-min 10 --r-max 1", "--r-max"},
+                     C{"calibrate cohesion --target-speed 7.6e-4 --points 1", "--points"},
+                     C{"calibrate cohesion --r-min 1", "--target-speed"}}) {
     SCOPED_TRACE(c.args);
     const auto r = cli(c.args + " --out " + d.string() + " --quiet");
     EXPECT_EQ(r.status, 2) << r.err;
@@ -65,5 +68,42 @@ TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
   const auto again = cli("experiment reduction --r 1 --time 2e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(nlohmann::json::parse(again.out)["points"], j["points"]);
+  fs::remove_all(d);
+}
+
+// `calibrate cohesion` on tiny reduction runs: an unreachable target is reported (exit 1, JSON
+// with a hint) without losing the runs; a target between the two round-0 speeds is bracketed
+// on the rerun (round 0 resumed, not recomputed) and refined inside the bracket.
+TEST(ExperimentCli, CohesionCalibrationBracketsATargetBetweenItsSpeeds) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_cal_coh_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const std::string common = "calibrate cohesion --preset color --r-min 1 --r-max 100 --points 2 --rounds 2 --time 4e-4 "
+                             "--pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string();
+  const auto miss = cli(common + " --target-speed 1");
+  ASSERT_EQ(miss.status, 1) << miss.err;
+  EXPECT_NE(miss.err.find("not bracketed"), std::string::npos) << miss.err;
+  const auto j0 = nlohmann::json::parse(nipdem::io::read_file(d / "cohesion.json"));
+  EXPECT_FALSE(j0["bracketed"].get<bool>());
+  ASSERT_EQ(j0["rounds"].size(), 1u);
+  const auto& p = j0["rounds"][0]["points"];
+  ASSERT_EQ(p.size(), 2u);
+  const double v1 = p[0]["reduction_speed_m_per_s"].get<double>(), v100 = p[1]["reduction_speed_m_per_s"].get<double>();
+  ASSERT_NE(v1, v100);
+  const auto hit = cli(common + " --target-speed " + std::to_string(0.5 * (v1 + v100)));
+  ASSERT_EQ(hit.status, 0) << hit.err;
+  const auto j = nlohmann::json::parse(hit.out);
+  ASSERT_TRUE(j["bracketed"].get<bool>());
+  EXPECT_EQ(j["rounds"][0]["points"], p);  // resumed: identical speeds
+  ASSERT_EQ(j["rounds"].size(), 2u);
+  for (const auto& q : j["rounds"][1]["points"]) {
+    EXPECT_GT(q["r"].get<double>(), j["bracket"][0].get<double>() - 1e-12);
+    EXPECT_GT(q["r"].get<double>(), 1.0);
+    EXPECT_LT(q["r"].get<double>(), 100.0);
+  }
+  const double r = j["r_fit"].get<double>();
+  EXPECT_GE(r, j["bracket"][0].get<double>());
+  EXPECT_LE(r, j["bracket"][1].get<double>());
+  EXPECT_TRUE(fs::exists(d / "cohesion.png"));
+  EXPECT_TRUE(fs::exists(d / "round_1" / "reduction.csv"));
   fs::remove_all(d);
 }

@@ -1,0 +1,75 @@
+// Calibration of the cohesion ratio r = F_coh / F_adh (eq. 4.6.1) against a measured
+// reduction speed (thesis §4.6, Table 4.3): a 1-D root search over reduction experiments.
+//
+// The reduction speed v(r) of the simulated assembly is noisy and, by the thesis's reading of
+// fig. 4.25, falls as r grows (cohesion keeps the assembly together against the sleeve). We do
+// not assume more than that v(r) - v_target changes sign somewhere in [r_min, r_max]:
+//  1. round 0 runs the reduction experiment at `points` log-spaced r in [r_min, r_max];
+//  2. the bracket is the adjacent pair (in r) whose speeds straddle the target (the lowest such
+//     pair if noise makes several; all are reported);
+//  3. each further round runs `points` new r log-spaced strictly inside the bracket
+//     (a `points`-section search: the bracket shrinks by points + 1 per round);
+//  4. r_fit interpolates v linearly in ln r between the final bracket's ends; the 1-sigma
+//     range maps the larger standard error of the two speeds through that slope.
+// Every round is an ordinary `experiment reduction` in OUT/round_<k>/ (resumable).
+#pragma once
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "nipdem/experiments/nip_experiments.hpp"
+
+namespace nipdem::calibrate {
+
+struct SpeedPoint {
+  double r = 0;            // cohesion ratio [-], > 0
+  double speed = 0;        // reduction speed [m/s]
+  double stderr_ = 0;      // its standard error [m/s] (0 if unknown)
+};
+
+struct CohesionFit {
+  bool bracketed = false;
+  double r_fit = 0;                    // [-]
+  double r_lo = 0, r_hi = 0;           // the bracket used
+  double r_1sigma_lo = 0, r_1sigma_hi = 0;
+  std::size_t crossings = 0;           // adjacent pairs straddling the target
+  std::string hint;                    // why not bracketed, and what to do
+};
+
+// Pure analysis: points in any order (r > 0, distinct). Throws InputError for r <= 0, fewer
+// than two points, or a non-finite speed.
+CohesionFit fit_cohesion_ratio(std::vector<SpeedPoint> points, double target_speed);
+
+// The r values of the next round: n log-spaced values strictly inside (lo, hi).
+std::vector<double> interior_log_points(double lo, double hi, std::size_t n);
+
+// One round's evaluation: the reduction speeds at the given r (a point may be missing if its
+// run gave no speed). `round` counts from 0.
+using SpeedEvaluator = std::function<std::vector<SpeedPoint>(std::size_t round, const std::vector<double>& r)>;
+
+struct CohesionSearch {
+  CohesionFit fit;
+  std::vector<SpeedPoint> points;                  // every evaluated point, sorted by r
+  std::vector<std::vector<double>> rounds_r;       // the r asked for in each round
+};
+
+struct CohesionOptions {
+  double target_speed_m_per_s = 0;     // e.g. Table 4.3: black 7.6e-4, colour 2.5e-4
+  double r_min = 0.1, r_max = 100.0;
+  std::size_t points = 4;              // r values per round
+  std::size_t rounds = 2;              // round 0 + refinements
+  experiments::ReductionOptions reduction;  // observation time, pile (cohesion_ratios ignored)
+};
+
+// The search of steps 1-4 on any evaluator (tested on analytic v(r)).
+CohesionSearch search_cohesion_ratio(const SpeedEvaluator& evaluate, const CohesionOptions& c);
+
+// Runs the rounds (threads only: each round depends on the last) and returns the JSON report
+// (CLI.md keys: r_fit, bracket, points, rounds, ...). Writes OUT/cohesion.csv and
+// OUT/cohesion.png (speed vs r with the target).
+nlohmann::json calibrate_cohesion(const experiments::ExperimentOptions& o, const CohesionOptions& c);
+
+}  // namespace nipdem::calibrate
