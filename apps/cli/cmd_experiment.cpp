@@ -95,6 +95,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--time", r->time_s, "observation time [s] (thesis: 0.1)")->capture_default_str();
     sub->add_option("--pile-width", r->pile_width_m, "initial assembly width [m]")->capture_default_str();
     sub->add_option("--pile-height", r->pile_height_m, "initial assembly height [m]")->capture_default_str();
+    sub->add_option("--pits", r->pits, "sleeve pits entering upstream: empty (clean sleeve), filled, or preset")->capture_default_str();
     sub->callback([=] {
       r->cohesion_ratios = parse_list(*rs, "--r");
       finish(c, "reduction", [&] { return reduction(c->o, *r); });
@@ -140,6 +141,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--time", k->reduction.time_s, "observation time per run [s] (thesis: 0.1)")->capture_default_str();
     sub->add_option("--pile-width", k->reduction.pile_width_m, "initial assembly width [m]")->capture_default_str();
     sub->add_option("--pile-height", k->reduction.pile_height_m, "initial assembly height [m]")->capture_default_str();
+    sub->add_option("--pits", k->reduction.pits, "sleeve pits entering upstream: empty (clean sleeve), filled, or preset")->capture_default_str();
     sub->callback([=] { finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion(c->o, *k); }); });
   }
 });

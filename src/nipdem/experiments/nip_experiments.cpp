@@ -1,5 +1,6 @@
 #include "nipdem/experiments/nip_experiments.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -42,6 +43,28 @@ ensemble::Options ens(const ExperimentOptions& o, std::size_t count, const std::
   return e;
 }
 
+// Progress inside one long run of an ensemble (a 100 ms reduction run takes hours): a line on
+// stderr at most every `every_s` of wall time, "label: t = 12.0 / 100.0 ms (12 %), 140 s".
+class Heartbeat {
+ public:
+  Heartbeat(bool on, std::string label, double t_end, double every_s = 60.0)
+      : on_(on), label_(std::move(label)), t_end_(t_end), every_(every_s), start_(std::chrono::steady_clock::now()), last_(start_) {}
+  void operator()(double t) {
+    if (!on_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < every_) return;
+    last_ = now;
+    std::fprintf(stderr, "%s: t = %.4g / %.4g ms (%.0f %%), %.0f s\n", label_.c_str(), t * 1e3, t_end_ * 1e3, 100.0 * t / t_end_,
+                 std::chrono::duration<double>(now - start_).count());
+  }
+
+ private:
+  bool on_;
+  std::string label_;
+  double t_end_, every_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
 json failures(const ensemble::Summary& s) {
   json f = json::array();
   for (const auto& r : s.records) if (!r.ok) f.push_back({{"index", r.index}, {"seed", r.seed}, {"error", r.error}});
@@ -78,8 +101,10 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     analysis::SteadyState st;
     analysis::ExtentOptions eo{analysis::FrontAt::min_x, 3, 0.02};  // ignore a few stray particles
     const double h = 0.5 * run.config().gap;
+    Heartbeat beat(o.progress, fmt::format("front_position[{}] gap {:g} um", i, points[i].first * 1e6), f.max_time_s);
     while (run.sim().time() < f.max_time_s) {
       run.advance_to(run.sim().time() + f.sample_interval_s);
+      beat(run.sim().time());
       const auto xs = run.assembly_x(h, run.config().roller_pits_filled ? 0.5 * run.config().size.d50 : -1.0);
       if (xs.size() < 8) continue;  // no assembly (yet)
       const auto e = analysis::assembly_extent(run.sim().time(), xs, eo);
@@ -133,13 +158,17 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   if (r.cohesion_ratios.empty()) throw_input("experiment reduction", "--r", "", "need at least one cohesion ratio");
   for (double v : r.cohesion_ratios) require_range("experiment reduction", "--r", v, 0.0, 1e6);
   require_range("experiment reduction", "--time", r.time_s, 1e-6, 10.0);
+  if (r.pits != "empty" && r.pits != "filled" && r.pits != "preset")
+    throw_input("experiment reduction", "--pits", r.pits, "allowed: empty, filled, preset");
   auto point_sets = [&](std::size_t i) {
     const double w = r.window_half_width_m;
-    return std::vector<std::string>{"adhesion.cohesion_ratio=" + num(r.cohesion_ratios[i]),
+    std::vector<std::string> s{"adhesion.cohesion_ratio=" + num(r.cohesion_ratios[i]),
                                     "geometry.gap_m=4e-3",  // no DI-drum: it is far away
                                     "inflow.layer_thickness_m=0", "inflow.prefill=false", "output.vtk=false",
                                     "electric.enabled=false",
                                     "geometry.window_x_min_m=" + num(-w), "geometry.window_x_max_m=" + num(w)};
+    if (r.pits != "preset") s.push_back("inflow.roller_pits=\"" + r.pits + "\"");
+    return s;
   };
   for (std::size_t i = 0; i < r.cohesion_ratios.size(); ++i) experiment_config(o, point_sets(i));
   auto task = [&](std::size_t i, std::uint64_t seed) {
@@ -152,8 +181,10 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
     // carried away in the roughness, not the assembly the thesis films (§4.6)
     analysis::ExtentOptions eo{analysis::FrontAt::max_x, 3, 0.05};
     const double half_dt = 0.5 * run.time_step().dt;  // time lands within dt/2 of a target
+    Heartbeat beat(o.progress, fmt::format("reduction[{}] r = {:g}", i, r.cohesion_ratios[i]), r.time_s);
     while (run.sim().time() < r.time_s - half_dt) {
       run.advance_to(std::min(r.time_s, run.sim().time() + r.sample_interval_s));
+      beat(run.sim().time());
       // the assembly above the land level: toner in filled pits is the sleeve's, not the pile's
       const auto xs = run.assembly_x(r.pile_height_m * 2.0, run.config().roller_pits_filled ? 0.5 * run.config().size.d50 : -1.0);
       if (xs.size() >= 8) ext.push_back(analysis::assembly_extent(run.sim().time(), xs, eo));
@@ -209,7 +240,7 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
     p.series.push_back(s);
     io::write_plot_png(o.out / "reduction.png", p);
   }
-  return {{"experiment", "reduction"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
+  return {{"experiment", "reduction"}, {"pits", r.pits}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
           {"table_4_3_reduction_speed_m_per_s", {{"black", 7.6e-4}, {"color", 2.5e-4}}},
           {"csv", (o.out / "reduction.csv").string()}, {"meta", meta(o)}};
 }
@@ -227,7 +258,8 @@ PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double vo
   const double v = std::fabs(cfg.drum_speed);
   const double t_end = (p.line_start_m + p.line_length_m + (cfg.nip_x - cfg.x_min)) / v + p.extra_time_s;
   NipRun run(cfg);
-  run.advance_to(t_end);
+  Heartbeat beat(o.progress, fmt::format("line at {:g} V (seed {})", voltage, seed % 100000), t_end);
+  run.advance_to(t_end, [&] { beat(run.sim().time()); });
   return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), run.sim().time()};
 }
 }  // namespace

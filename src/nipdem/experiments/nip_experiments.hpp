@@ -47,6 +47,11 @@ struct ReductionOptions {
   double pile_height_m = 120e-6;
   double pile_area_fraction = 0.6;
   double window_half_width_m = 600e-6;
+  // Sleeve pits entering upstream of the pile: "empty" (default: at the start only the pile
+  // carries toner, and in 100 ms no point of the sleeve comes round again from the supply
+  // roller: 5 cm (black) / 2 cm (colour) of travel on a 12.6 cm circumference), "filled"
+  // (as in the running machine, docs/geometry.md) or "preset" (the configuration's value).
+  std::string pits = "empty";
 };
 nlohmann::json reduction(const ExperimentOptions& o, const ReductionOptions& r);
 
