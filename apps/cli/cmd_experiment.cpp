@@ -107,6 +107,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     auto* sub = g->add_subcommand("vo-level", "Lowest drum voltage that prints (§5.2), statistics over seeds");
     add_common(sub, c, "vo-level");
     sub->add_option("--step", v->step_V, "voltage step [V]")->capture_default_str();
+    sub->add_option("--coarse-step", v->coarse_step_V, "0, or a multiple of --step: step coarsely, then refine below the first printing voltage (docs/analysis.md)")->capture_default_str();
     sub->add_option("--v0", v->v0_V, "first voltage [V]")->capture_default_str();
     sub->add_option("--vmax", v->v_max_V, "give up above this voltage [V]")->capture_default_str();
     sub->add_option("--seeds", v->seeds, "independent realizations")->capture_default_str();

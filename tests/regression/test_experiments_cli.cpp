@@ -43,7 +43,8 @@ TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
                      C{"calibrate cohesion --target-speed 7.6e-4 --r-min 10 --r-max 1", "--r-max"},
                      C{"calibrate cohesion --target-speed 7.6e-4 --points 1", "--points"},
                      C{"calibrate cohesion --r-min 1", "--target-speed"},
-                     C{"experiment reduction --pits half", "--pits"}}) {
+                     C{"experiment reduction --pits half", "--pits"},
+                     C{"experiment vo-level --coarse-step 1.2", "coarse_step_V"}}) {
     SCOPED_TRACE(c.args);
     const auto r = cli(c.args + " --out " + d.string() + " --quiet");
     EXPECT_EQ(r.status, 2) << r.err;

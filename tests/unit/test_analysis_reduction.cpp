@@ -126,6 +126,44 @@ TEST(AnalysisVo, SteppingFindsFirstPrintingVoltage) {
   EXPECT_THROW(find_vo_level(count, {30.0, 0.5, 20.0}), InputError);
 }
 
+TEST(AnalysisVo, CoarseThenFineEqualsPlainSteppingForAThreshold) {
+  // For every threshold between 0 and 30 V (0.1 V apart), coarse 5 V steps refined in 0.5 V give
+  // the same Vo as plain 0.5 V stepping from 0 V, with fewer runs once Vo is above ~5 V.
+  for (int t10 = 0; t10 <= 300; ++t10) {
+    const double thr = 0.1 * t10;
+    auto count = [thr](double V) { return V >= thr - 1e-9 ? 1L : 0L; };
+    const VoResult plain = find_vo_level(count, {0.0, 0.5, 40.0});
+    VoSearchOptions o{0.0, 0.5, 40.0};
+    o.coarse_step_V = 5.0;
+    const VoResult fast = find_vo_level(count, o);
+    SCOPED_TRACE(thr);
+    ASSERT_TRUE(fast.found);
+    EXPECT_DOUBLE_EQ(fast.vo_V, plain.vo_V);
+    EXPECT_LE(fast.trace.size(), plain.trace.size() + 8);
+    if (plain.vo_V >= 10.0) {
+      EXPECT_LT(fast.trace.size(), plain.trace.size());
+    }
+    for (auto& [V, c] : fast.trace) EXPECT_DOUBLE_EQ(std::remainder(V, 0.5), 0.0);  // on the fine grid
+  }
+  // v_max not a multiple of the coarse step: the last fine voltage below it is still tried
+  auto late = [](double V) { return V >= 11.5 ? 1L : 0L; };
+  VoSearchOptions o{0.0, 0.5, 12.0};
+  o.coarse_step_V = 5.0;
+  const VoResult r = find_vo_level(late, o);
+  ASSERT_TRUE(r.found);
+  EXPECT_DOUBLE_EQ(r.vo_V, 11.5);
+  // 0, 5, 10, 12 (prints), then 10.5, 11, 11.5 (prints)
+  EXPECT_EQ(r.trace.size(), 7u);
+  // A voltage that prints and then stops printing below the coarse level is the documented miss
+  auto blip = [](double V) { return (V == 2.0 || V >= 7.0) ? 1L : 0L; };
+  EXPECT_DOUBLE_EQ(find_vo_level(blip, {0.0, 0.5, 40.0}).vo_V, 2.0);
+  EXPECT_DOUBLE_EQ(find_vo_level(blip, o).vo_V, 7.0);
+  o.coarse_step_V = 1.25;  // not a multiple of 0.5
+  EXPECT_THROW(find_vo_level(late, o), InputError);
+  o.coarse_step_V = -5.0;  // wrong sign
+  EXPECT_THROW(find_vo_level(late, o), InputError);
+}
+
 TEST(AnalysisVo, StatisticsOverSeeds) {
   // Per-seed threshold 40 + (seed mod 4) * 0.5 - 0.1 V with 0.5 V steps from 38 V gives Vo =
   // 40, 40.5, 41, 41.5 for seeds 0..3: mean 40.75, sample std sqrt(5/12) * 0.5 * ... computed

@@ -17,6 +17,12 @@ struct VoSearchOptions {
   double v0_V = 0.0;      // first voltage tried [V]
   double step_V = 0.5;    // step [V]; negative to search downwards in (negative) voltage
   double v_max_V = 100.0; // give up beyond this voltage (inclusive bound in the step direction)
+  // 0: plain stepping. Otherwise a multiple m >= 2 of step_V (same sign): step by it until a
+  // voltage Vc prints, then try Vc - coarse + step, ..., Vc - step. Every voltage tried lies on
+  // the fine grid v0 + k step, and the result equals plain stepping whenever no voltage below
+  // the last non-printing coarse level would print (printing that switches off again as V
+  // rises is missed). Costs ~ (Vo - v0)/coarse + m - 1 runs instead of (Vo - v0)/step + 1.
+  double coarse_step_V = 0.0;
 };
 
 struct VoResult {

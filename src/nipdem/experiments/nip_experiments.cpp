@@ -267,12 +267,14 @@ PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double vo
 json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   require_range("experiment vo-level", "--step", v.step_V, 1e-3, 100.0);
   if (v.seeds < 1) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "need >= 1");
+  // the search options are checked once here (exit 2), not in every seed's task
+  analysis::find_vo_level([](double) { return 1L; }, {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V});
   // reject a bad configuration or line before any run starts (exit 2, not failed points)
   experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=" + num(v.print.line_start_m),
                         "print.length_m=" + num(v.print.line_length_m)});
   auto task = [&](std::size_t, std::uint64_t seed) {
     const auto res = analysis::find_vo_level([&](double V) { return print_line(o, v.print, V, seed).printed; },
-                                             {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V});
+                                             {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V});
     json trace = json::array();
     for (auto& [V, n] : res.trace) trace.push_back({V, n});
     return json{{"found", res.found}, {"vo_V", res.vo_V}, {"trace_V_printed", trace}};
@@ -291,7 +293,7 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   if (!vo.empty()) mean /= vo.size();
   for (double x : vo) sd += (x - mean) * (x - mean);
   if (vo.size() > 1) sd = std::sqrt(sd / (vo.size() - 1));
-  return {{"experiment", "vo-level"}, {"vo_mean_V", vo.empty() ? json(nullptr) : json(mean)}, {"vo_std_V", sd},
+  return {{"experiment", "vo-level"}, {"step_V", v.step_V}, {"coarse_step_V", v.coarse_step_V}, {"vo_mean_V", vo.empty() ? json(nullptr) : json(mean)}, {"vo_std_V", sd},
           {"seeds_found", vo.size()}, {"seeds_total", v.seeds}, {"per_seed", per}, {"failed", failures(sum)},
           {"n_failed", sum.n_failed}, {"meta", meta(o)}};
 }

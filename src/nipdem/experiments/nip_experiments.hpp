@@ -62,6 +62,7 @@ struct PrintOptions {
 };
 struct VoOptions {
   double v0_V = 0.0, step_V = 0.5, v_max_V = 60.0;
+  double coarse_step_V = 0.0;          // 0: plain stepping (analysis::VoSearchOptions)
   int seeds = 3;
   PrintOptions print;
 };
