@@ -62,6 +62,14 @@ TEST(CohesionFit, NoisyDataWithSeveralCrossingsUsesTheLowestAndCountsThem) {
   EXPECT_NEAR(f.r_fit, std::sqrt(2.0), 1e-12);  // halfway in ln r
 }
 
+TEST(CohesionFit, CountsPairsThatGoAgainstTheTrendBeyondTwoSigma) {
+  // rising overall; 2 -> 3 falls by 3e-4 with a combined error of 1.4e-4 (> 2 sigma), 4 -> 5
+  // falls by 1e-4 (< 2 sigma: noise)
+  const std::vector<SpeedPoint> p{{1, 0.0, 1e-4}, {2, 1e-4, 1e-4}, {3, -2e-4, 1e-4}, {4, 4e-4, 1e-4}, {5, 3e-4, 1e-4}};
+  EXPECT_EQ(fit_cohesion_ratio(p, 2.5e-4).against_trend, 1u);
+  EXPECT_EQ(fit_cohesion_ratio(sample({0.1, 1.0, 10.0}, loglin, 1e-6), 8e-4).against_trend, 0u);
+}
+
 TEST(CohesionFit, BadInputIsAnInputError) {
   EXPECT_THROW(fit_cohesion_ratio({{1.0, 1e-4, 0}}, 1e-4), InputError);
   EXPECT_THROW(fit_cohesion_ratio({{0.0, 1e-4, 0}, {1.0, 2e-4, 0}}, 1e-4), InputError);

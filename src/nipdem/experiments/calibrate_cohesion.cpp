@@ -26,6 +26,12 @@ CohesionFit fit_cohesion_ratio(std::vector<SpeedPoint> pts, double target) {
   }
   std::sort(pts.begin(), pts.end(), [](const SpeedPoint& a, const SpeedPoint& b) { return a.r < b.r; });
   CohesionFit f;
+  const double trend = pts.back().speed - pts.front().speed;
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double d = pts[i + 1].speed - pts[i].speed;
+    const double se = std::hypot(pts[i].stderr_, pts[i + 1].stderr_);
+    if (d * trend < 0.0 && std::abs(d) > 2.0 * se) ++f.against_trend;
+  }
   std::size_t first = pts.size();
   for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
     const double a = pts[i].speed - target, b = pts[i + 1].speed - target;
@@ -180,6 +186,7 @@ json calibrate_cohesion(const experiments::ExperimentOptions& o, const CohesionO
          {"target_speed_m_per_s", c.target_speed_m_per_s},
          {"bracketed", fit.bracketed},
          {"crossings", fit.crossings},
+         {"pairs_against_trend_2sigma", fit.against_trend},
          {"rounds", rounds},
          {"observation_time_s", c.reduction.time_s},
          {"failed", failed},

@@ -36,6 +36,10 @@ struct CohesionFit {
   double r_lo = 0, r_hi = 0;           // the bracket used
   double r_1sigma_lo = 0, r_1sigma_hi = 0;
   std::size_t crossings = 0;           // adjacent pairs straddling the target
+  // adjacent pairs (in r) whose change opposes the overall trend (last vs first point) by more
+  // than twice their combined standard error: the noise is not only statistical, or v(r) is
+  // not monotone; r_1sigma then understates the uncertainty
+  std::size_t against_trend = 0;
   std::string hint;                    // why not bracketed, and what to do
 };
 
