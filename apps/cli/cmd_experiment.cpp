@@ -125,6 +125,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--line-length", e->print.line_length_m, "printed line length on the drum [m]")->capture_default_str();
     sub->add_option("--line-start", e->print.line_start_m, "drum position where the line starts [m] (s = 0 at the nip at t = 0)")->capture_default_str();
     sub->add_option("--extra-time", e->print.extra_time_s, "run this long after the line's end has left the window [s] (printing goes on after the track is off)")->capture_default_str()->check(CLI::Range(0.0, 1.0));
+    sub->add_option("--margin", e->margin_m, "analysis range beyond each end of the line [m]; each run lasts until line end + margin has left the window")->capture_default_str();
     sub->add_option("--bootstrap", e->bootstrap, "bootstrap resamples")->capture_default_str();
     sub->callback([=] { finish(c, "edge-sharpness", [&] { return edge_sharpness(c->o, *e); }); });
   }

@@ -40,6 +40,7 @@ TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
                      C{"experiment vo-level --line-start 5", "start_m"},
                      C{"experiment edge-sharpness --line-start 5", "start_m"},
                      C{"experiment edge-sharpness --extra-time -1", "--extra-time"},
+                     C{"experiment edge-sharpness --margin 0", "--margin"},
                      C{"calibrate cohesion --target-speed 7.6e-4 --r-min 10 --r-max 1", "--r-max"},
                      C{"calibrate cohesion --target-speed 7.6e-4 --points 1", "--points"},
                      C{"calibrate cohesion --r-min 1", "--target-speed"},
@@ -72,6 +73,39 @@ TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
   const auto again = cli("experiment reduction --r 1 --time 2e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(nlohmann::json::parse(again.out)["points"], j["points"]);
+  fs::remove_all(d);
+}
+
+// Two tiny printed lines (120 um window, 20 um line): every realization observes the drum up to
+// line end + margin (drum still in the window at the end is unobserved, not uncovered), the JSON
+// reports the coverage at the range ends, and a folder whose realization lacks that record (made
+// by an older nipdem with a shorter run) is rejected with exit 2 instead of being averaged.
+TEST(ExperimentCli, TinyEdgeSharpnessObservesTheWholeAnalysisRange) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_edge_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const std::string cmd = "experiment edge-sharpness --realizations 2 --line-start 0 --line-length 20e-6 --margin 20e-6 "
+                          "--set geometry.window_x_min_m=-60e-6 --set geometry.window_x_max_m=60e-6 "
+                          "--set collision.stiffness_scale=0.01 --json --quiet --out " + d.string();
+  const auto r = cli(cmd);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["realizations"], 2);
+  for (int i = 0; i < 2; ++i) {
+    const auto rj = nlohmann::json::parse(nipdem::io::read_file(d / "edge_sharpness" / "realizations" / (std::to_string(i) + ".json")));
+    EXPECT_GE(rj["result"]["s_observed_m"].get<double>(), 40e-6 - 1e-6);  // line end + margin, within a bin
+  }
+  if (j.contains("error")) {
+    EXPECT_FALSE(j.contains("coverage_at_range_end"));  // nothing printed: nothing to fit
+  } else {
+    EXPECT_TRUE(j.contains("coverage_at_range_end"));
+    EXPECT_TRUE(j["warnings"].is_array());
+  }
+  auto r0 = nlohmann::json::parse(nipdem::io::read_file(d / "edge_sharpness" / "realizations" / "0.json"));
+  r0["result"].erase("s_observed_m");
+  nipdem::io::write_file_atomic(d / "edge_sharpness" / "realizations" / "0.json", r0.dump());
+  const auto again = cli(cmd);
+  EXPECT_EQ(again.status, 2);
+  EXPECT_NE(again.err.find("s_observed_m"), std::string::npos) << again.err;
   fs::remove_all(d);
 }
 

@@ -247,20 +247,24 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
 
 // ---------------------------------------------------------------- printing (§5.2, §5.3)
 namespace {
-struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; };
+struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; double s_observed_m; };
 
-PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double voltage, std::uint64_t seed) {
+// Prints one line; runs until the drum up to `tail_m` beyond the line's end has left the window
+// (+ extra_time_s). s_observed_m: the drum coordinate up to which the drum has left the window.
+PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double voltage, std::uint64_t seed, double tail_m = 0.0) {
   std::vector<std::string> sets = {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=" + num(voltage),
                                    "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
                                    "output.vtk=false", "run.seed=" + std::to_string(seed % (1ULL << 62))};
   NipConfig cfg = experiment_config(o, sets);
   // run until the end of the line has passed the window's downstream edge
   const double v = std::fabs(cfg.drum_speed);
-  const double t_end = (p.line_start_m + p.line_length_m + (cfg.nip_x - cfg.x_min)) / v + p.extra_time_s;
+  const double ride = cfg.nip_x - cfg.x_min;  // nip to the window's downstream edge along the drum
+  const double t_end = (p.line_start_m + p.line_length_m + tail_m + ride) / v + p.extra_time_s;
   NipRun run(cfg);
   Heartbeat beat(o.progress, fmt::format("line at {:g} V (seed {})", voltage, seed % 100000), t_end);
   run.advance_to(t_end, [&] { beat(run.sim().time()); });
-  return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), run.sim().time()};
+  const double t = run.sim().time();
+  return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), t, v * t - ride};
 }
 }  // namespace
 
@@ -302,18 +306,19 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   if (e.realizations < 2) throw_input("experiment edge-sharpness", "--realizations", std::to_string(e.realizations), "need >= 2");
   const NipConfig base = experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=40",
                                                 "print.start_m=" + num(e.print.line_start_m), "print.length_m=" + num(e.print.line_length_m)});
+  require_range("experiment edge-sharpness", "--margin", e.margin_m, 20e-6, 5e-3);
   const double volts = base.electric.pattern.segments().empty() ? 40.0 : base.electric.pattern.segments()[0].voltage_V;
   auto task = [&](std::size_t, std::uint64_t seed) {
-    const auto pr = print_line(o, e.print, volts, seed);
+    const auto pr = print_line(o, e.print, volts, seed, e.margin_m);
     json bins = json::array();
     for (const auto& b : pr.coverage) bins.push_back({b.s0, b.covered ? 1 : 0});
-    return json{{"printed", pr.printed}, {"bins_s_covered", bins}};
+    return json{{"printed", pr.printed}, {"bins_s_covered", bins}, {"s_observed_m", pr.s_observed_m}};
   };
   const auto sum = ensemble::run(task, ens(o, static_cast<std::size_t>(e.realizations), "edge_sharpness"));
   if (!sum.is_root) return {};
-  // Common grid over all realizations: bin width d50/4 from the line start - 200 um to end + 200 um.
+  // Common grid over all realizations: bin width d50/4 from the line start - margin to end + margin.
   const double bin = 0.25 * base.size.d50;
-  const double lo = e.print.line_start_m - 200e-6, hi = e.print.line_start_m + e.print.line_length_m + 200e-6;
+  const double lo = e.print.line_start_m - e.margin_m, hi = e.print.line_start_m + e.print.line_length_m + e.margin_m;
   const int n = static_cast<int>(std::lround((hi - lo) / bin));
   std::vector<double> x(n);
   for (int k = 0; k < n; ++k) x[k] = lo + (k + 0.5) * bin;
@@ -321,6 +326,13 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   long printed_total = 0;
   for (const auto& r : sum.records) {
     if (!r.ok) continue;
+    // Drum still inside the window at the run's end is unobserved, not uncovered: a realization
+    // (e.g. resumed from a folder made with a shorter run) must have observed the whole grid.
+    const double seen = r.result.contains("s_observed_m") ? r.result["s_observed_m"].get<double>() : -1.0;
+    if (seen < hi - 0.5 * bin)
+      throw_input((o.out / "edge_sharpness" / "realizations").string(), "realization " + std::to_string(r.index) + " s_observed_m",
+                  r.result.contains("s_observed_m") ? num(seen) : "missing (made by an older nipdem)",
+                  fmt::format("every line must have observed the drum up to the analysis range's end, line end + margin = {:.4g} m; use a new --out", hi));
     std::vector<double> c(n, 0.0);
     for (auto& b : r.result["bins_s_covered"]) {
       const int k = static_cast<int>(std::floor((b[0].get<double>() + 0.5 * bin - lo) / bin));
@@ -340,6 +352,18 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
     out["edge_back_m"] = nullptr;
     return out;
   }
+  // Coverage at the ends of the analysis range (first / last d50 of it, relative to the peak): an
+  // edge that has not decayed there is cut by the range, and its width is biased.
+  const int edge_bins = std::max(1, std::min(n / 4, 4));
+  double c_lo = 0, c_hi = 0;
+  for (int k = 0; k < edge_bins; ++k) c_lo += avg[k] / edge_bins, c_hi += avg[n - 1 - k] / edge_bins;
+  out["coverage_at_range_start"] = c_lo / peak;
+  out["coverage_at_range_end"] = c_hi / peak;
+  json warnings = json::array();
+  if (c_lo > 0.1 * peak) warnings.push_back(fmt::format("coverage at the range start is {:.0f} % of the peak: the front edge is cut by the analysis range; use a larger --margin", 100 * c_lo / peak));
+  if (c_hi > 0.1 * peak) warnings.push_back(fmt::format("coverage at the range end is {:.0f} % of the peak: printing goes on past line end + margin; use a larger --margin", 100 * c_hi / peak));
+  for (const auto& w : warnings) std::fprintf(stderr, "nipdem: warning: edge-sharpness: %s\n", w.get<std::string>().c_str());
+  out["warnings"] = warnings;
   analysis::SigmoidOptions so;
   so.binomial_realizations = static_cast<int>(curves.size());
   // The drum carries the line towards -x; its front (printed first) is at low s.

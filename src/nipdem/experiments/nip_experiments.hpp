@@ -72,6 +72,10 @@ struct EdgeOptions {
   int realizations = 50;
   PrintOptions print;
   int bootstrap = 400;
+  // Analysis range beyond each end of the line. Each run lasts until the drum up to line end +
+  // margin has left the window (plus --extra-time): drum that is still in the window at the end
+  // is unobserved, and counting it as "not covered" would cut the back edge (docs/analysis.md).
+  double margin_m = 200e-6;
 };
 nlohmann::json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e);
 
