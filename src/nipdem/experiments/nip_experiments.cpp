@@ -256,7 +256,7 @@ PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double vo
                                    "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
                                    "output.vtk=false", "run.seed=" + std::to_string(seed % (1ULL << 62))};
   NipConfig cfg = experiment_config(o, sets);
-  // run until the end of the line has passed the window's downstream edge
+  // run until the drum up to line end + tail_m has passed the window's downstream edge
   const double v = std::fabs(cfg.drum_speed);
   const double ride = cfg.nip_x - cfg.x_min;  // nip to the window's downstream edge along the drum
   const double t_end = (p.line_start_m + p.line_length_m + tail_m + ride) / v + p.extra_time_s;
