@@ -1,6 +1,7 @@
 // Sigmoid edge fits and bootstrap (thesis §1.4 / §5.3, edge sharpness = 10–90 % width).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -235,4 +236,55 @@ TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {
   io::write_plot_png(dir / "coverage.png", coverage_plot(x, b.average, b.fit, "edge sharpness"));
   EXPECT_TRUE(std::filesystem::exists(dir / "coverage.png"));
   std::filesystem::remove_all(dir);
+}
+
+// The edge-sharpness driver warns when an edge is cut by the analysis range (docs/analysis.md,
+// "Observation range"): the true line profile sampled on a full grid and on grids that end
+// inside the back edge or start inside the front edge.
+TEST(AnalysisRangeEnds, CutEdgesAreFlaggedAndAFullLineIsNot) {
+  const TrueLine line;  // rise at 0 (200 um wide), fall at 600 um (120 um wide)
+  auto sample = [&](double a, double b) {
+    std::vector<double> c;
+    for (double x : grid(a, b, 10e-6)) c.push_back(line.p(x));
+    return c;
+  };
+  // Full: the range extends 1.5 widths beyond each edge; the logistic is < 1 % there.
+  const auto full = range_end_coverage(sample(-300e-6, 900e-6));
+  EXPECT_LT(full.at_start, 0.01);
+  EXPECT_LT(full.at_end, 0.01);
+  EXPECT_FALSE(full.start_cut);
+  EXPECT_FALSE(full.end_cut);
+  EXPECT_TRUE(full.warnings.empty());
+  // Ends 20 um after the fall's centre: the last 4 bins (590-620 um) average ~0.55 of the peak.
+  const auto cut_curve = sample(-300e-6, 620e-6);
+  const double peak = *std::max_element(cut_curve.begin(), cut_curve.end());
+  const auto cut_end = range_end_coverage(cut_curve);
+  EXPECT_NEAR(cut_end.at_end, (line.p(590e-6) + line.p(600e-6) + line.p(610e-6) + line.p(620e-6)) / 4 / peak, 1e-12);
+  EXPECT_TRUE(cut_end.end_cut);
+  EXPECT_FALSE(cut_end.start_cut);
+  ASSERT_EQ(cut_end.warnings.size(), 1u);
+  EXPECT_NE(cut_end.warnings[0].find("range end"), std::string::npos);
+  EXPECT_NE(cut_end.warnings[0].find("--margin"), std::string::npos);
+  // Starts at the rise's centre: coverage there ~0.5-0.6 of the peak.
+  const auto cut_start = range_end_coverage(sample(0.0, 900e-6));
+  EXPECT_TRUE(cut_start.start_cut);
+  EXPECT_FALSE(cut_start.end_cut);
+  ASSERT_EQ(cut_start.warnings.size(), 1u);
+  EXPECT_NE(cut_start.warnings[0].find("range start"), std::string::npos);
+  // Relative to the peak, so a line printed at 40 % coverage is judged the same way.
+  auto faint = sample(-300e-6, 620e-6);
+  for (double& c : faint) c *= 0.4;
+  EXPECT_NEAR(range_end_coverage(faint).at_end, cut_end.at_end, 1e-12);
+}
+
+TEST(AnalysisRangeEnds, ThresholdIsStrictAndBadCurvesAreInputErrors) {
+  // Last 4 of 16 points at 9 % of the peak: not cut (the threshold is 10 %).
+  std::vector<double> c(16, 1.0);
+  for (int k = 12; k < 16; ++k) c[k] = 0.09;
+  for (int k = 0; k < 4; ++k) c[k] = 0.0;
+  EXPECT_FALSE(range_end_coverage(c).end_cut);
+  c[15] = 0.2;  // mean of the last 4 = 0.1175
+  EXPECT_TRUE(range_end_coverage(c).end_cut);
+  EXPECT_THROW(range_end_coverage(std::vector<double>(10, 0.0)), InputError);
+  EXPECT_THROW(range_end_coverage(std::vector<double>{1.0}), InputError);
 }

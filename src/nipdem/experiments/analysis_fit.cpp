@@ -310,6 +310,27 @@ double evaluate(const LineEdgesFit& f, double x) {
   return f.floor + (f.ceiling - f.floor) * logistic((x - f.rise.x0) / f.rise.w) * logistic((x - f.fall.x0) / f.fall.w);
 }
 
+RangeEndCoverage range_end_coverage(const std::vector<double>& avg, int edge_bins, double threshold) {
+  const int n = static_cast<int>(avg.size());
+  if (n < 2) throw_input("coverage range ends", "points", std::to_string(n), "need >= 2");
+  double peak = 0;
+  for (double c : avg) peak = std::max(peak, c);
+  if (!(peak > 0)) throw_input("coverage range ends", "peak coverage", std::to_string(peak), "need > 0 (nothing printed)");
+  const int m = std::max(1, std::min(n / 4, edge_bins));
+  double lo = 0, hi = 0;
+  for (int k = 0; k < m; ++k) lo += avg[k] / m, hi += avg[n - 1 - k] / m;
+  RangeEndCoverage r;
+  r.at_start = lo / peak;
+  r.at_end = hi / peak;
+  r.start_cut = r.at_start > threshold;
+  r.end_cut = r.at_end > threshold;
+  if (r.start_cut)
+    r.warnings.push_back(fmt::format("coverage at the range start is {:.0f} % of the peak: the edge there is cut by the analysis range; use a larger --margin", 100 * r.at_start));
+  if (r.end_cut)
+    r.warnings.push_back(fmt::format("coverage at the range end is {:.0f} % of the peak: printing goes on past line end + margin; use a larger --margin", 100 * r.at_end));
+  return r;
+}
+
 std::vector<double> average_curve(const std::vector<std::vector<double>>& real) {
   if (real.empty()) throw_input("coverage average", "realizations", "0", "no realizations to average");
   const std::size_t n = real[0].size();

@@ -95,6 +95,18 @@ double evaluate(const LineEdgesFit& f, double x);
 // Mean over realizations of curves sampled on one grid (all the same length).
 std::vector<double> average_curve(const std::vector<std::vector<double>>& realizations);
 
+// Coverage of an average curve at the two ends of its analysis range, relative to its peak:
+// the mean over the first / last `edge_bins` points (default: one d50 of bins of d50/4, capped
+// at a quarter of the curve). An edge that has not decayed to `threshold` of the peak there is
+// cut by the range and its fitted width is biased; each such end gets a warning naming it.
+struct RangeEndCoverage {
+  double at_start = 0, at_end = 0;  // fraction of the peak
+  bool start_cut = false, end_cut = false;
+  std::vector<std::string> warnings;
+};
+// Throws InputError on fewer than 2 points or a curve without a positive peak.
+RangeEndCoverage range_end_coverage(const std::vector<double>& avg, int edge_bins = 4, double threshold = 0.1);
+
 struct Interval {
   double lo = 0, hi = 0;
 };

@@ -352,18 +352,12 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
     out["edge_back_m"] = nullptr;
     return out;
   }
-  // Coverage at the ends of the analysis range (first / last d50 of it, relative to the peak): an
-  // edge that has not decayed there is cut by the range, and its width is biased.
-  const int edge_bins = std::max(1, std::min(n / 4, 4));
-  double c_lo = 0, c_hi = 0;
-  for (int k = 0; k < edge_bins; ++k) c_lo += avg[k] / edge_bins, c_hi += avg[n - 1 - k] / edge_bins;
-  out["coverage_at_range_start"] = c_lo / peak;
-  out["coverage_at_range_end"] = c_hi / peak;
-  json warnings = json::array();
-  if (c_lo > 0.1 * peak) warnings.push_back(fmt::format("coverage at the range start is {:.0f} % of the peak: the front edge is cut by the analysis range; use a larger --margin", 100 * c_lo / peak));
-  if (c_hi > 0.1 * peak) warnings.push_back(fmt::format("coverage at the range end is {:.0f} % of the peak: printing goes on past line end + margin; use a larger --margin", 100 * c_hi / peak));
-  for (const auto& w : warnings) std::fprintf(stderr, "nipdem: warning: edge-sharpness: %s\n", w.get<std::string>().c_str());
-  out["warnings"] = warnings;
+  // An edge that has not decayed at an end of the analysis range is cut by it (first / last d50).
+  const auto ends = analysis::range_end_coverage(avg);
+  out["coverage_at_range_start"] = ends.at_start;
+  out["coverage_at_range_end"] = ends.at_end;
+  for (const auto& w : ends.warnings) std::fprintf(stderr, "nipdem: warning: edge-sharpness: %s\n", w.c_str());
+  out["warnings"] = ends.warnings;
   analysis::SigmoidOptions so;
   so.binomial_realizations = static_cast<int>(curves.size());
   // The drum carries the line towards -x; its front (printed first) is at low s.
