@@ -3,6 +3,7 @@
 // checkpoint + resume reproduces an uninterrupted run byte for byte.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip.hpp"
 #include "nipdem/experiments/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
@@ -229,4 +231,67 @@ TEST(NipPits, SleeveCarriesOutWhatItBringsIn) {
   // (1-3 toner per pit): allow 3 sqrt(N) + 2 between in and out, 25 % against the density.
   EXPECT_LE(std::fabs(in - out), 3.0 * std::sqrt(expected) + 2.0);
   EXPECT_NEAR(in, expected, 0.25 * expected);
+}
+
+// A Vo-level scan simulates the start of a print run once per seed (the track is at its off
+// voltage until the line starts) and resumes every voltage from that checkpoint. The resumed
+// run must equal an uninterrupted run at that voltage exactly, and the voltage must matter
+// after the switch (else the equality proves nothing).
+namespace {
+// The small nip narrowed to a 60 um gap and filled with an assembly that bridges drum and roller
+// (in a 150 um gap the knife pulls all toner of this short window off the drum, and nothing
+// charges); a 10 um line starts at s = 30 um (0.27 ms).
+NipConfig print_nip(double voltage, int seed = 11) {
+  return parse_nip_config(preset_text("black"), "preset:black",
+                          {"geometry.window_x_min_m=-150e-6", "geometry.window_x_max_m=150e-6", "collision.stiffness_scale=0.01",
+                           "geometry.gap_m=60e-6", "initial_assembly.enabled=true", "initial_assembly.x_min_m=-140e-6", "initial_assembly.x_max_m=140e-6",
+                           "output.vtk=false", "electric.enabled=true", "electric.charge_preset=\"black\"", "print.pattern=\"line\"", "print.start_m=30e-6",
+                           "print.length_m=10e-6", "run.seed=" + std::to_string(seed), "print.voltage_V=" + std::to_string(voltage)});
+}
+struct State { std::vector<std::int64_t> id; std::vector<double> x, y, vx, vy, omega; std::int64_t developed, inserted; };
+State state_of(const NipRun& r) {
+  const auto& b = r.sim().bodies();
+  return {b.id, b.x, b.y, b.vx, b.vy, b.omega, r.removed(Exit::developed), r.inserted()};
+}
+}  // namespace
+
+TEST(NipPrintPrefix, ResumingEveryVoltageFromOneStartEqualsAnUninterruptedRun) {
+  NipRun at1(print_nip(1.0));
+  const double dt = at1.time_step().dt;
+  const double t_on = at1.first_print_switch_time();
+  EXPECT_NEAR(t_on, 30e-6 / std::fabs(at1.config().drum_speed), 1e-15);
+  const double t_end = t_on + 10e-6 / std::fabs(at1.config().drum_speed) + 50 * dt;
+  at1.advance_to(t_on - 2 * dt);
+  const std::string prefix = at1.checkpoint();
+  std::vector<State> uninterrupted;
+  double u_max_40 = 0.0;
+  for (double volts : {40.0, 0.0}) {
+    NipRun whole(print_nip(volts));
+    whole.advance_to(t_end);
+    for (double u : whole.electric()->voltage()) if (volts == 40.0) u_max_40 = std::max(u_max_40, std::fabs(u));
+    NipRun resumed(print_nip(volts));
+    resumed.restore_before_print_switch(prefix);
+    resumed.advance_to(t_end);
+    const State a = state_of(whole), b = state_of(resumed);
+    uninterrupted.push_back(a);
+    ASSERT_EQ(a.id, b.id) << volts << " V";
+    EXPECT_EQ(a.x, b.x) << volts << " V";
+    EXPECT_EQ(a.y, b.y);
+    EXPECT_EQ(a.vx, b.vx);
+    EXPECT_EQ(a.vy, b.vy);
+    EXPECT_EQ(a.omega, b.omega);
+    EXPECT_EQ(a.developed, b.developed);
+    EXPECT_EQ(a.inserted, b.inserted);
+  }
+  // 40 V and 0 V differ after the switch (toner touching the drum charges towards 40 V): the
+  // equality above is not the trivial one.
+  EXPECT_GT(u_max_40, 5.0);
+  EXPECT_NE(uninterrupted[0].vy, uninterrupted[1].vy);
+  // A checkpoint after the switch, or of another configuration, is refused.
+  NipRun late(print_nip(1.0));
+  late.advance_to(t_on + 5 * dt);
+  NipRun target(print_nip(40.0));
+  EXPECT_THROW(target.restore_before_print_switch(late.checkpoint()), InputError);
+  NipRun other_seed(print_nip(40.0, 12));
+  EXPECT_THROW(other_seed.restore_before_print_switch(prefix), InputError);
 }

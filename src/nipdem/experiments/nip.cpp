@@ -1,7 +1,10 @@
 #include "nipdem/experiments/nip.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
+
+#include <fmt/format.h>
 
 #include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/constants.hpp"
@@ -298,8 +301,9 @@ void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) 
 // ---- checkpoint: runner state, then the engine's (same binary helpers as the engine) ----
 std::string NipRun::checkpoint() const {
   std::ostringstream o;
-  o.write("NIPDEMRUN2", 10);
+  o.write("NIPDEMRUN3", 10);
   binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.resume_key)));
+  binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.prefix_key)));
   for (int i = 0; i < 4; ++i) binary::put(o, rng_.state()[i]);
   binary::put(o, inserted_);
   binary::put(o, inserted_roller_);
@@ -310,14 +314,32 @@ std::string NipRun::checkpoint() const {
   return o.str();
 }
 
-void NipRun::restore(const std::string& blob) {
-  if (blob.compare(0, 10, "NIPDEMRUN2") != 0) throw std::runtime_error("not a nipdem run checkpoint of this version");
-  std::istringstream in(blob);
+namespace {
+// Reads the header of a run checkpoint; version 2 (before 2026-12-02) has no prefix key.
+struct CheckpointHeader { std::uint64_t resume_hash = 0, prefix_hash = 0; bool has_prefix = false; };
+CheckpointHeader read_checkpoint_header(std::istream& in, const std::string& blob) {
+  CheckpointHeader h;
+  const bool v3 = blob.compare(0, 10, "NIPDEMRUN3") == 0;
+  if (!v3 && blob.compare(0, 10, "NIPDEMRUN2") != 0) throw std::runtime_error("not a nipdem run checkpoint of this version");
   in.ignore(10);
-  std::uint64_t h;
-  binary::get(in, h);
-  if (h != std::hash<std::string>{}(cfg_.resume_key))
+  binary::get(in, h.resume_hash);
+  if (v3) {
+    binary::get(in, h.prefix_hash);
+    h.has_prefix = true;
+  }
+  return h;
+}
+}  // namespace
+
+void NipRun::restore(const std::string& blob) {
+  std::istringstream in(blob);
+  const auto h = read_checkpoint_header(in, blob);
+  if (h.resume_hash != std::hash<std::string>{}(cfg_.resume_key))
     throw InputError("checkpoint was written with a different configuration; --resume needs the same config and --set options (only run.end_time_s and the output intervals may change)");
+  restore_state(in);
+}
+
+void NipRun::restore_state(std::istream& in) {
   std::uint64_t st[4];
   for (auto& v : st) binary::get(in, v);
   rng_.set_state(st);
@@ -327,6 +349,31 @@ void NipRun::restore(const std::string& blob) {
   binary::get(in, area_debt_);
   binary::get_vec(in, removals_);
   sim_->load(in);
+}
+
+double NipRun::first_print_switch_time() const {
+  if (!cfg_.electric.enabled || cfg_.drum_speed == 0.0) return std::numeric_limits<double>::infinity();
+  const auto& pat = cfg_.electric.pattern;
+  // the track position s = v t sweeps from 0 towards the sign of v
+  double first = std::numeric_limits<double>::infinity();
+  for (const auto& seg : pat.segments()) {
+    if (seg.voltage_V == pat.off_voltage()) continue;
+    const double s = cfg_.drum_speed > 0 ? seg.begin_m : -seg.end_m;
+    if (s <= 0.0) return 0.0;
+    first = std::min(first, s / std::fabs(cfg_.drum_speed));
+  }
+  return first;
+}
+
+void NipRun::restore_before_print_switch(const std::string& blob) {
+  std::istringstream in(blob);
+  const auto h = read_checkpoint_header(in, blob);
+  if (!h.has_prefix || h.prefix_hash != std::hash<std::string>{}(cfg_.prefix_key))
+    throw InputError("prefix checkpoint was written with a configuration that differs in more than print.voltage_V");
+  restore_state(in);
+  const double t_on = first_print_switch_time();
+  if (!(sim_->time() + ts_.dt <= t_on))
+    throw InputError(fmt::format("prefix checkpoint at t = {:g} s is not before the drum track first switches on (t = {:g} s)", sim_->time(), t_on));
 }
 
 nlohmann::json NipRun::describe() const {

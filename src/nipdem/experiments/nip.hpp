@@ -10,6 +10,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <istream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -81,6 +82,14 @@ class NipRun {
   // Checkpoint of the whole run (engine + runner state) and its restore.
   std::string checkpoint() const;
   void restore(const std::string& blob);
+  // Restores a checkpoint of a run whose configuration differs from this one at most in
+  // print.voltage_V and that was taken before the drum track first switches on. Until then
+  // both runs see the off voltage and take the same steps, so one prefix serves every voltage
+  // of a Vo-level scan (tested bitwise against an uninterrupted run). Throws InputError if the
+  // configurations differ otherwise or the checkpoint's time is not before the first switch.
+  void restore_before_print_switch(const std::string& blob);
+  // Time at which the drum track first switches away from its off voltage (inf: never).
+  double first_print_switch_time() const;
   // Geometry and parameters for summary.json / rendering.
   nlohmann::json describe() const;
 
@@ -94,6 +103,8 @@ class NipRun {
   bool try_insert_on_roller(double x_lo, double x_hi, double h_lo, double h_hi);
   bool place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega);
   void prefill();
+  // The checkpoint after its header (rng, counters, removals, engine).
+  void restore_state(std::istream& in);
   // Fills the pits of the whole window (start) or the pit(s) that entered through x_min
   // during the last inflow pass; returns the count.
   int fill_pits_entering(bool whole_window);

@@ -221,6 +221,10 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   std::ostringstream rk;
   rk << root;
   c.resume_key = rk.str();
+  if (auto* print = root["print"].as_table()) print->erase("voltage_V");
+  std::ostringstream pk;
+  pk << root;
+  c.prefix_key = pk.str();
   choose_time_step(c);  // refuses a time step above the stability bound
   return c;
 }

@@ -90,6 +90,9 @@ struct NipConfig {
   std::vector<ClusterTemplate> templates;  // resolved library
   std::string resolved_toml;               // the effective configuration (for summary.json)
   std::string resume_key;                  // the configuration minus keys a resume may change
+  // resume_key minus print.voltage_V: runs that differ only in the track's on voltage are
+  // identical until the track first switches on (NipRun::restore_before_print_switch).
+  std::string prefix_key;
 };
 
 // Loads and validates. `overrides` are KEY=VALUE strings (from --set).

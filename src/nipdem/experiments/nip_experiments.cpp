@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -249,22 +250,43 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
 namespace {
 struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; double s_observed_m; };
 
+std::vector<std::string> print_sets(const PrintOptions& p, double voltage, std::uint64_t seed) {
+  return {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=" + num(voltage),
+          "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
+          "output.vtk=false", "run.seed=" + std::to_string(seed % (1ULL << 62))};
+}
+
 // Prints one line; runs until the drum up to `tail_m` beyond the line's end has left the window
 // (+ extra_time_s). s_observed_m: the drum coordinate up to which the drum has left the window.
-PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double voltage, std::uint64_t seed, double tail_m = 0.0) {
-  std::vector<std::string> sets = {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=" + num(voltage),
-                                   "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
-                                   "output.vtk=false", "run.seed=" + std::to_string(seed % (1ULL << 62))};
-  NipConfig cfg = experiment_config(o, sets);
+// `prefix`: a checkpoint from print_prefix() for the same seed, taken before the track switches
+// on; the run starts from it instead of from t = 0 (identical result, less work).
+PrintRun print_line(const ExperimentOptions& o, const PrintOptions& p, double voltage, std::uint64_t seed, double tail_m = 0.0,
+                    const std::string* prefix = nullptr) {
+  NipConfig cfg = experiment_config(o, print_sets(p, voltage, seed));
   // run until the drum up to line end + tail_m has passed the window's downstream edge
   const double v = std::fabs(cfg.drum_speed);
   const double ride = cfg.nip_x - cfg.x_min;  // nip to the window's downstream edge along the drum
   const double t_end = (p.line_start_m + p.line_length_m + tail_m + ride) / v + p.extra_time_s;
   NipRun run(cfg);
+  if (prefix) run.restore_before_print_switch(*prefix);
   Heartbeat beat(o.progress, fmt::format("line at {:g} V (seed {})", voltage, seed % 100000), t_end);
   run.advance_to(t_end, [&] { beat(run.sim().time()); });
   const double t = run.sim().time();
   return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), t, v * t - ride};
+}
+
+// The part of a print run before the drum track first switches on: the same for every voltage
+// of one seed (the track is at its off voltage until then), so a Vo-level scan simulates it once.
+// Stops two time steps before the switch; returns the checkpoint there (nothing if the track
+// switches on within the first insert interval: then there is nothing worth sharing).
+std::optional<std::string> print_prefix(const ExperimentOptions& o, const PrintOptions& p, std::uint64_t seed) {
+  NipRun run(experiment_config(o, print_sets(p, 1.0, seed)));
+  const double dt = run.time_step().dt;
+  const double t_stop = run.first_print_switch_time() - 2.0 * dt;
+  if (!(t_stop > run.config().insert_interval * dt) || !std::isfinite(t_stop)) return std::nullopt;
+  Heartbeat beat(o.progress, fmt::format("common start before the line (seed {})", seed % 100000), t_stop);
+  run.advance_to(t_stop, [&] { beat(run.sim().time()); });
+  return run.checkpoint();
 }
 }  // namespace
 
@@ -277,7 +299,8 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=" + num(v.print.line_start_m),
                         "print.length_m=" + num(v.print.line_length_m)});
   auto task = [&](std::size_t, std::uint64_t seed) {
-    const auto res = analysis::find_vo_level([&](double V) { return print_line(o, v.print, V, seed).printed; },
+    const auto prefix = print_prefix(o, v.print, seed);
+    const auto res = analysis::find_vo_level([&](double V) { return print_line(o, v.print, V, seed, 0.0, prefix ? &*prefix : nullptr).printed; },
                                              {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V});
     json trace = json::array();
     for (auto& [V, n] : res.trace) trace.push_back({V, n});
