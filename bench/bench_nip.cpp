@@ -14,7 +14,7 @@
 //
 // Usage: bench_nip [--steps N=2000] [--settle N] [--threads T=1] [--half-width M=4.2e-3]
 //                  [--state dense|loose] [--dense-file FILE] [--repeat R=1]
-//                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M=2e-6]
+//                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M (default magnet.dipole_skin_m, 8e-6)]
 //                  [--set key=value ...]   (extra config overrides, as `nipdem run --set`)
 #include <algorithm>
 #include <chrono>
@@ -301,7 +301,7 @@ State make_dense_state(const std::vector<std::string>& base, double press_time, 
   return snapshot(sim);
 }
 
-double g_dipole_skin = -1;  // --dipole-skin: MagnetConfig::dipole_skin (not a config key)
+double g_dipole_skin = -1;  // --dipole-skin: overrides magnet.dipole_skin_m
 
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
   if (start) overrides.push_back("inflow.prefill=false");

@@ -40,7 +40,7 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   p.dt = ts_.dt;
   p.gravity = cfg_.gravity;
   p.interactions = make_interactions(cfg_);
-  p.skin = 0.1 * cfg_.size.d50;
+  p.skin = cfg_.list_skin_d50 * cfg_.size.d50;
   p.threads = cfg_.threads;
 
   // Both rollers turn clockwise: the roller's top moves towards +x, the drum's bottom towards -x.

@@ -48,6 +48,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
                        ? engine::Integrator::velocity_verlet : engine::Integrator::newmark_explicit;
     c.dt = s.number("dt_s", 0.0, 1e-3, 0.0);
     c.dt_fraction = s.number("dt_fraction_of_contact_time", 1e-4, 0.5, c.dt_fraction);
+    c.list_skin_d50 = s.number("neighbor_skin_d50", 0.01, 2.0, c.list_skin_d50);
     s.finish();
   }
   {
@@ -146,6 +147,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     c.magnet.toner.eta = s.number("pigment_volume_fraction", 1e-6, 1.0, c.magnet.toner.eta);
     c.magnet.dipole_dipole = s.boolean("dipole_dipole", c.magnet.dipole_dipole);
     c.magnet.dipole_cutoff = s.number("dipole_cutoff_m", 1e-7, 1e-3, c.magnet.dipole_cutoff);
+    c.magnet.dipole_skin = s.number("dipole_skin_m", 1e-8, 1e-4, c.magnet.dipole_skin);
     c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000, c.magnet.dipole_interval));
     c.magnet.field_interval = static_cast<int>(s.integer("field_interval_steps", 1, 100000, c.magnet.field_interval));
     s.finish();

@@ -35,6 +35,8 @@ struct NipConfig {
   engine::Integrator integrator = engine::Integrator::velocity_verlet;
   double dt = 0.0;                   // [s]; 0 = dt_fraction * smallest contact time
   double dt_fraction = 0.04;         // of the smallest contact time
+  double list_skin_d50 = 0.3;        // contact neighbour-list skin [d50]: a speed knob only,
+                                     // the forces do not depend on it (docs/performance.md)
   // [geometry]
   double gap = 150e-6;               // w_h [m] (§4.1)
   double drum_radius = 0.02;         // [m]

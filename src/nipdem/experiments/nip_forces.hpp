@@ -24,7 +24,7 @@ struct MagnetConfig {
   bool dipole_dipole = true;
   double dipole_cutoff = 42e-6;    // [m]: 8 R50 (docs/magnetic.md: ~1.3 % mean truncation error)
   int dipole_interval = 10;        // steps between dipole-dipole re-evaluations
-  double dipole_skin = 2e-6;       // [m] reach of the persistent dipole pair list beyond the
+  double dipole_skin = 8e-6;       // [m] reach of the persistent dipole pair list beyond the
                                    // cut-off (saves the search only: the sum is exact within it)
   int field_interval = 10;         // steps between magnet-field force re-evaluations: a toner moves
                                    // < 0.1 um in 10 steps, the field varies over >= 100 um
