@@ -277,7 +277,7 @@ TEST(AnalysisRangeEnds, CutEdgesAreFlaggedAndAFullLineIsNot) {
   EXPECT_NEAR(range_end_coverage(faint).at_end, cut_end.at_end, 1e-12);
 }
 
-TEST(AnalysisRangeEnds, ThresholdIsStrictAndBadCurvesAreInputErrors) {
+TEST(AnalysisRangeEnds, BelowTheThresholdIsNotCutAndBadCurvesAreInputErrors) {
   // Last 4 of 16 points at 9 % of the peak: not cut (the threshold is 10 %).
   std::vector<double> c(16, 1.0);
   for (int k = 12; k < 16; ++k) c[k] = 0.09;
