@@ -55,6 +55,15 @@ TEST(AnalysisPlot, NiceTicks) {
   EXPECT_LE(t.back(), 12.1e-6);
   EXPECT_EQ(io::log_ticks(1e-3, 1e2).size(), 6u);  // 6 decades: powers of ten only
   EXPECT_EQ(io::log_ticks(1.0, 10.0), (std::vector<double>{1, 2, 5, 10}));
+  // a range within one 1-2-5 step (the reduction plot of 563 and 600 removed toner) still gets
+  // labelled ticks: linear steps inside the range
+  const auto narrow = io::log_ticks(560.0, 602.0);
+  ASSERT_GE(narrow.size(), 3u);
+  for (double v : narrow) {
+    EXPECT_GE(v, 560.0);
+    EXPECT_LE(v, 602.0);
+  }
+  EXPECT_EQ(io::log_ticks(0.9, 1.1).size(), 5u);  // 0.9, 0.95, 1.0, 1.05, 1.1 (1 alone was a 1-2-5 value)
   EXPECT_EQ(io::tick_label(0.25, 0.05), "0.25");
   EXPECT_EQ(io::tick_label(150, 50), "150");
   EXPECT_EQ(io::tick_label(2e-6, 1e-6), "2e-06");

@@ -127,6 +127,13 @@ std::vector<double> log_ticks(double lo, double hi) {
       if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9)) ticks.push_back(v);
     }
   }
+  // A range inside a factor of ~2.5 holds at most one 1-2-5 value: label it with linear steps
+  // instead (still placed on the log scale), so the axis is never left without numbers.
+  if (ticks.size() < 2) {
+    ticks.clear();
+    for (double v : nice_ticks(lo, hi, 5))
+      if (v > 0) ticks.push_back(v);
+  }
   return ticks;
 }
 
