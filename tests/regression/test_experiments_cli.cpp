@@ -3,6 +3,7 @@
 // known input in tests/unit/test_analysis_*.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -94,6 +95,17 @@ TEST(ExperimentCli, TinyEdgeSharpnessObservesTheWholeAnalysisRange) {
     const auto rj = nlohmann::json::parse(nipdem::io::read_file(d / "edge_sharpness" / "realizations" / (std::to_string(i) + ".json")));
     EXPECT_GE(rj["result"]["s_observed_m"].get<double>(), 40e-6 - 1e-6);  // line end + margin, within a bin
   }
+  // lines.csv: a header and one row per line, with that line's seed and printed count
+  const auto lines = nipdem::io::read_file(d / "lines.csv");
+  EXPECT_EQ(lines.rfind("index,seed,ok,wall_s,printed,s_observed_um,covered_bin_starts_um\n", 0), 0u) << lines;
+  EXPECT_EQ(std::count(lines.begin(), lines.end(), '\n'), 3);
+  const auto r1 = nlohmann::json::parse(nipdem::io::read_file(d / "edge_sharpness" / "realizations" / "1.json"));
+  const std::string head1 = "\n1," + std::to_string(r1["seed"].get<std::uint64_t>()) + ",1,";
+  const auto at = lines.find(head1);
+  ASSERT_NE(at, std::string::npos) << lines;
+  const auto wall_end = lines.find(',', at + head1.size());  // after wall_s comes printed
+  EXPECT_EQ(lines.substr(wall_end + 1, lines.find(',', wall_end + 1) - wall_end - 1),
+            std::to_string(r1["result"]["printed"].get<long>())) << lines;
   if (j.contains("error")) {
     EXPECT_FALSE(j.contains("coverage_at_range_end"));  // nothing printed: nothing to fit
   } else {

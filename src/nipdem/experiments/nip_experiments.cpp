@@ -364,8 +364,20 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
     printed_total += r.result["printed"].get<long>();
     curves.push_back(c);
   }
+  // One row per line (failed ones too): enough to redo the analysis on another grid.
+  std::string lines = "index,seed,ok,wall_s,printed,s_observed_um,covered_bin_starts_um\n";
+  for (const auto& r : sum.records) {
+    lines += fmt::format("{},{},{},{:.1f},", r.index, r.seed, r.ok ? 1 : 0, r.wall_s);
+    if (!r.ok) { lines += ",,\n"; continue; }
+    lines += fmt::format("{},{:.1f},", r.result["printed"].get<long>(), 1e6 * r.result["s_observed_m"].get<double>());
+    std::string starts;
+    for (auto& b : r.result["bins_s_covered"])
+      if (b[1].get<int>()) starts += (starts.empty() ? "" : ";") + fmt::format("{:.3f}", 1e6 * b[0].get<double>());
+    lines += starts + "\n";
+  }
+  io::write_file_atomic(o.out / "lines.csv", lines);
   json out = {{"experiment", "edge-sharpness"}, {"realizations", curves.size()}, {"printed_particles", printed_total},
-              {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"meta", meta(o)}};
+              {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"lines_file", (o.out / "lines.csv").string()}, {"meta", meta(o)}};
   const auto avg = curves.empty() ? std::vector<double>(n, 0.0) : analysis::average_curve(curves);
   double peak = 0;
   for (double c : avg) peak = std::max(peak, c);
