@@ -46,7 +46,14 @@ TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {
                      C{"calibrate cohesion --target-speed 7.6e-4 --points 1", "--points"},
                      C{"calibrate cohesion --r-min 1", "--target-speed"},
                      C{"experiment reduction --pits half", "--pits"},
-                     C{"experiment vo-level --coarse-step 1.2", "coarse_step_V"}}) {
+                     C{"experiment vo-level --coarse-step 1.2", "coarse_step_V"},
+                     // a key the experiment sets itself is refused, not silently replaced
+                     C{"experiment reduction --set geometry.gap_m=-1", "--set geometry.gap_m"},
+                     C{"experiment reduction --set adhesion.cohesion_ratio=3", "use --r instead"},
+                     C{"experiment front-position --set geometry.gap_m=1e-4", "use --gap instead"},
+                     C{"experiment vo-level --set print.voltage_V=20", "use --v0 and --step instead"},
+                     C{"experiment edge-sharpness --set print.start_m=1e-3", "use --line-start instead"},
+                     C{"experiment edge-sharpness --set run.seed=7", "use --seed instead"}}) {
     SCOPED_TRACE(c.args);
     const auto r = cli(c.args + " --out " + d.string() + " --quiet");
     EXPECT_EQ(r.status, 2) << r.err;
@@ -86,11 +93,12 @@ TEST(ExperimentCli, TinyEdgeSharpnessObservesTheWholeAnalysisRange) {
   fs::remove_all(d);
   const std::string cmd = "experiment edge-sharpness --realizations 2 --line-start 0 --line-length 20e-6 --margin 20e-6 "
                           "--set geometry.window_x_min_m=-60e-6 --set geometry.window_x_max_m=60e-6 "
-                          "--set collision.stiffness_scale=0.01 --json --quiet --out " + d.string();
+                          "--set collision.stiffness_scale=0.01 --set print.voltage_V=35 --json --quiet --out " + d.string();
   const auto r = cli(cmd);
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["realizations"], 2);
+  EXPECT_EQ(j["voltage_V"].get<double>(), 35.0);  // the configuration's print voltage, not a fixed one
   for (int i = 0; i < 2; ++i) {
     const auto rj = nlohmann::json::parse(nipdem::io::read_file(d / "edge_sharpness" / "realizations" / (std::to_string(i) + ".json")));
     EXPECT_GE(rj["result"]["s_observed_m"].get<double>(), 40e-6 - 1e-6);  // line end + margin, within a bin

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 #include <optional>
+#include <sstream>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -14,6 +15,7 @@
 #include "nipdem/experiments/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/plot.hpp"
+#include "nipdem/io/toml_reader.hpp"
 #include "nipdem/version.hpp"
 
 namespace nipdem::experiments {
@@ -26,6 +28,44 @@ NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::s
   sets.insert(sets.end(), point_sets.begin(), point_sets.end());
   if (!o.config.empty()) return load_nip_config(o.config, sets);
   return parse_nip_config(preset_text(o.preset), "preset:" + o.preset, sets);
+}
+
+void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment, const std::vector<std::string>& fixed,
+                       const std::map<std::string, std::string>& use_instead) {
+  auto key_of = [](const std::string& a) { return a.substr(0, a.find('=')); };
+  for (const auto& f : fixed) {
+    const std::string key = key_of(f);
+    for (const auto& u : o.sets) {
+      if (key_of(u) != key) continue;
+      const auto hint = use_instead.find(key);
+      throw_input("experiment " + experiment, "--set " + key, u.substr(std::min(u.size(), key.size() + 1)),
+                  "this experiment sets the key itself (" + f + ") and would replace the value",
+                  hint != use_instead.end() ? "use " + hint->second + " instead" : "leave it out");
+    }
+  }
+  // The same key in the configuration file is replaced too: say so once, not silently.
+  try {
+    const std::string text = o.config.empty() ? preset_text(o.preset) : io::read_file(o.config);
+    const toml::table root = io::parse_toml(text, o.config.empty() ? "preset:" + o.preset : o.config);
+    for (const auto& f : fixed) {
+      const std::string key = key_of(f);
+      if (f.substr(key.size()) == "=*") continue;  // varies from run to run (seed, voltage step)
+      const toml::node_view<const toml::node> have = root.at_path(key);
+      if (!have) continue;
+      const toml::table want = io::parse_toml("v = " + f.substr(key.size() + 1), "--set");
+      const auto a = have.value<double>(), b = want["v"].value<double>();
+      std::ostringstream sa, sb;
+      sa << have;
+      sb << want["v"];
+      if ((a && b) ? *a == *b : sa.str() == sb.str()) continue;
+      const auto hint = use_instead.find(key);
+      std::fprintf(stderr, "nipdem: note: experiment %s sets %s%s; the configuration's %s = %s is not used\n", experiment.c_str(), f.c_str(),
+                   hint != use_instead.end() ? (" (" + hint->second + ")").c_str() : "", key.c_str(),
+                   a ? fmt::format("{:g}", *a).c_str() : sa.str().c_str());
+    }
+  } catch (const InputError&) {
+    // an unreadable configuration is reported by experiment_config with its own message
+  }
 }
 
 namespace {
@@ -93,7 +133,13 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     if (points[i].second >= 0) s.push_back("geometry.roller_surface_speed_m_per_s=" + num(points[i].second));
     return s;
   };
-  for (std::size_t i = 0; i < points.size(); ++i) experiment_config(o, point_sets(i));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    auto fixed = point_sets(i);
+    fixed.push_back("run.seed=*");
+    reject_fixed_sets(o, "front-position", fixed,
+                      {{"geometry.gap_m", "--gap"}, {"geometry.roller_surface_speed_m_per_s", "--sleeve-speed"}, {"run.seed", "--seed"}});
+    experiment_config(o, point_sets(i));
+  }
   auto task = [&](std::size_t i, std::uint64_t seed) {
     auto sets = point_sets(i);
     sets.push_back("run.seed=" + std::to_string(seed % (1ULL << 62)));
@@ -171,7 +217,12 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
     if (r.pits != "preset") s.push_back("inflow.roller_pits=\"" + r.pits + "\"");
     return s;
   };
-  for (std::size_t i = 0; i < r.cohesion_ratios.size(); ++i) experiment_config(o, point_sets(i));
+  for (std::size_t i = 0; i < r.cohesion_ratios.size(); ++i) {
+    auto fixed = point_sets(i);
+    fixed.push_back("run.seed=*");
+    reject_fixed_sets(o, "reduction", fixed, {{"adhesion.cohesion_ratio", "--r"}, {"inflow.roller_pits", "--pits"}, {"run.seed", "--seed"}});
+    experiment_config(o, point_sets(i));
+  }
   auto task = [&](std::size_t i, std::uint64_t seed) {
     auto sets = point_sets(i);
     sets.push_back("run.seed=" + std::to_string(seed % (1ULL << 62)));
@@ -250,6 +301,9 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
 namespace {
 struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; double s_observed_m; };
 
+const std::map<std::string, std::string> kPrintHints = {
+    {"print.voltage_V", "--v0 and --step"}, {"print.start_m", "--line-start"}, {"print.length_m", "--line-length"}, {"run.seed", "--seed"}};
+
 std::vector<std::string> print_sets(const PrintOptions& p, double voltage, std::uint64_t seed) {
   return {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=" + num(voltage),
           "print.start_m=" + num(p.line_start_m), "print.length_m=" + num(p.line_length_m),
@@ -296,6 +350,10 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   // the search options are checked once here (exit 2), not in every seed's task
   analysis::find_vo_level([](double) { return 1L; }, {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V});
   // reject a bad configuration or line before any run starts (exit 2, not failed points)
+  auto fixed = print_sets(v.print, 0.0, 0);
+  for (auto& f : fixed)
+    if (f.rfind("print.voltage_V=", 0) == 0 || f.rfind("run.seed=", 0) == 0) f = f.substr(0, f.find('=')) + "=*";
+  reject_fixed_sets(o, "vo-level", fixed, kPrintHints);
   experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=1", "print.start_m=" + num(v.print.line_start_m),
                         "print.length_m=" + num(v.print.line_length_m)});
   auto task = [&](std::size_t, std::uint64_t seed) {
@@ -327,7 +385,12 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
 
 json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   if (e.realizations < 2) throw_input("experiment edge-sharpness", "--realizations", std::to_string(e.realizations), "need >= 2");
-  const NipConfig base = experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"", "print.voltage_V=40",
+  // The line is printed at the configuration's print.voltage_V (default 40 V, §5.3).
+  std::vector<std::string> fixed;
+  for (const auto& f : print_sets(e.print, 0.0, 0))
+    if (f.rfind("print.voltage_V=", 0) != 0) fixed.push_back(f.rfind("run.seed=", 0) == 0 ? "run.seed=*" : f);
+  reject_fixed_sets(o, "edge-sharpness", fixed, kPrintHints);
+  const NipConfig base = experiment_config(o, {"electric.enabled=true", "print.pattern=\"line\"",
                                                 "print.start_m=" + num(e.print.line_start_m), "print.length_m=" + num(e.print.line_length_m)});
   require_range("experiment edge-sharpness", "--margin", e.margin_m, 20e-6, 5e-3);
   const double volts = base.electric.pattern.segments().empty() ? 40.0 : base.electric.pattern.segments()[0].voltage_V;
@@ -376,7 +439,7 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
     lines += starts + "\n";
   }
   io::write_file_atomic(o.out / "lines.csv", lines);
-  json out = {{"experiment", "edge-sharpness"}, {"realizations", curves.size()}, {"printed_particles", printed_total},
+  json out = {{"experiment", "edge-sharpness"}, {"voltage_V", volts}, {"realizations", curves.size()}, {"printed_particles", printed_total},
               {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"lines_file", (o.out / "lines.csv").string()}, {"meta", meta(o)}};
   const auto avg = curves.empty() ? std::vector<double>(n, 0.0) : analysis::average_curve(curves);
   double peak = 0;

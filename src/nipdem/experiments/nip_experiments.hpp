@@ -9,6 +9,7 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -82,5 +83,12 @@ nlohmann::json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e);
 // Base configuration of an experiment point: preset or file, then the user's --set, then
 // the point's own overrides.
 NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::string>& point_sets);
+
+// Exit 2 (InputError) if a user --set names a key in `fixed` ("key=value"; value "*" = varies
+// per run): the experiment's own value would replace it silently. `use_instead` maps a key to
+// the option that sets it. A fixed key present in the configuration file with another value is
+// noted on stderr (the experiment's value is used).
+void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment, const std::vector<std::string>& fixed,
+                       const std::map<std::string, std::string>& use_instead = {});
 
 }  // namespace nipdem::experiments
