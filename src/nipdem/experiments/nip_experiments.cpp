@@ -31,7 +31,7 @@ NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::s
 }
 
 void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment, const std::vector<std::string>& fixed,
-                       const std::map<std::string, std::string>& use_instead) {
+                       const std::map<std::string, std::string>& use_instead, bool note_config) {
   auto key_of = [](const std::string& a) { return a.substr(0, a.find('=')); };
   for (const auto& f : fixed) {
     const std::string key = key_of(f);
@@ -43,13 +43,16 @@ void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment
                   hint != use_instead.end() ? "use " + hint->second + " instead" : "leave it out");
     }
   }
-  // The same key in the configuration file is replaced too: say so once, not silently.
+  // A key the user could set with an option is replaced in the configuration file too: say so
+  // (once per experiment), not silently. Keys that define the experiment (the reduction's
+  // 4 mm gap, no inflow, no VTK) are replaced without a note.
+  if (!note_config) return;
   try {
     const std::string text = o.config.empty() ? preset_text(o.preset) : io::read_file(o.config);
     const toml::table root = io::parse_toml(text, o.config.empty() ? "preset:" + o.preset : o.config);
     for (const auto& f : fixed) {
       const std::string key = key_of(f);
-      if (f.substr(key.size()) == "=*") continue;  // varies from run to run (seed, voltage step)
+      if (f.substr(key.size()) == "=*" || !use_instead.count(key)) continue;  // varies per run, or defines the experiment
       const toml::node_view<const toml::node> have = root.at_path(key);
       if (!have) continue;
       const toml::table want = io::parse_toml("v = " + f.substr(key.size() + 1), "--set");
@@ -137,7 +140,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     auto fixed = point_sets(i);
     fixed.push_back("run.seed=*");
     reject_fixed_sets(o, "front-position", fixed,
-                      {{"geometry.gap_m", "--gap"}, {"geometry.roller_surface_speed_m_per_s", "--sleeve-speed"}, {"run.seed", "--seed"}});
+                      {{"geometry.gap_m", "--gap"}, {"geometry.roller_surface_speed_m_per_s", "--sleeve-speed"}, {"run.seed", "--seed"}}, i == 0);
     experiment_config(o, point_sets(i));
   }
   auto task = [&](std::size_t i, std::uint64_t seed) {
@@ -220,7 +223,7 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   for (std::size_t i = 0; i < r.cohesion_ratios.size(); ++i) {
     auto fixed = point_sets(i);
     fixed.push_back("run.seed=*");
-    reject_fixed_sets(o, "reduction", fixed, {{"adhesion.cohesion_ratio", "--r"}, {"inflow.roller_pits", "--pits"}, {"run.seed", "--seed"}});
+    reject_fixed_sets(o, "reduction", fixed, {{"adhesion.cohesion_ratio", "--r"}, {"inflow.roller_pits", "--pits"}, {"run.seed", "--seed"}}, i == 0);
     experiment_config(o, point_sets(i));
   }
   auto task = [&](std::size_t i, std::uint64_t seed) {

@@ -86,9 +86,9 @@ NipConfig experiment_config(const ExperimentOptions& o, const std::vector<std::s
 
 // Exit 2 (InputError) if a user --set names a key in `fixed` ("key=value"; value "*" = varies
 // per run): the experiment's own value would replace it silently. `use_instead` maps a key to
-// the option that sets it. A fixed key present in the configuration file with another value is
-// noted on stderr (the experiment's value is used).
+// the option that sets it. If `note_config`, a key of `use_instead` present in the configuration
+// file with another value is noted on stderr (the experiment's value is used).
 void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment, const std::vector<std::string>& fixed,
-                       const std::map<std::string, std::string>& use_instead = {});
+                       const std::map<std::string, std::string>& use_instead = {}, bool note_config = true);
 
 }  // namespace nipdem::experiments
