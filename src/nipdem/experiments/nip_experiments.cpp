@@ -61,10 +61,8 @@ void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment
       sa << have;
       sb << want["v"];
       if ((a && b) ? *a == *b : sa.str() == sb.str()) continue;
-      const auto hint = use_instead.find(key);
-      std::fprintf(stderr, "nipdem: note: experiment %s sets %s%s; the configuration's %s = %s is not used\n", experiment.c_str(), f.c_str(),
-                   hint != use_instead.end() ? (" (" + hint->second + ")").c_str() : "", key.c_str(),
-                   a ? fmt::format("{:g}", *a).c_str() : sa.str().c_str());
+      std::fprintf(stderr, "nipdem: note: experiment %s sets %s (%s); the configuration's %s = %s is not used\n", experiment.c_str(), f.c_str(),
+                   use_instead.at(key).c_str(), key.c_str(), a ? fmt::format("{:g}", *a).c_str() : sa.str().c_str());
     }
   } catch (const InputError&) {
     // an unreadable configuration is reported by experiment_config with its own message
