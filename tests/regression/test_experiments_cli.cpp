@@ -77,10 +77,31 @@ TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
   EXPECT_EQ(p["brought_in_pits"].get<int>(), 0);
   EXPECT_TRUE(fs::exists(d / "reduction.csv"));
   EXPECT_TRUE(fs::exists(d / "reduction.json"));
+  EXPECT_EQ(p["series_csv"].get<std::string>(), (d / "reduction_r1.csv").string());
+  EXPECT_TRUE(fs::exists(d / "reduction_r1.csv"));
   // resumable: a rerun loads the finished point instead of recomputing it
   const auto again = cli("experiment reduction --r 1 --time 2e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
   ASSERT_EQ(again.status, 0) << again.err;
   EXPECT_EQ(nlohmann::json::parse(again.out)["points"], j["points"]);
+  fs::remove_all(d);
+}
+
+// An r given twice is two seeds of one point: each keeps its own time series (the second used
+// to overwrite the first's reduction_r1.csv).
+TEST(ExperimentCli, RepeatedCohesionRatioKeepsEachSeedsSeries) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_red2_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const auto r = cli("experiment reduction --r 1,1 --time 1e-5 --pile-width 100e-6 --pile-height 40e-6 --set collision.stiffness_scale=0.01 --json --quiet --out " + d.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 2u);
+  EXPECT_NE(j["points"][0]["seed"], j["points"][1]["seed"]);
+  for (int i = 0; i < 2; ++i) {
+    const fs::path f = d / ("reduction_r1_i" + std::to_string(i) + ".csv");
+    EXPECT_EQ(j["points"][i]["series_csv"].get<std::string>(), f.string());
+    EXPECT_TRUE(fs::exists(f)) << f;
+  }
+  EXPECT_FALSE(fs::exists(d / "reduction_r1.csv"));
   fs::remove_all(d);
 }
 

@@ -1,5 +1,6 @@
 #include "nipdem/experiments/nip_experiments.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -275,10 +276,16 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
                        row.value("reduction_speed_stderr_m_per_s", NAN));
     s.x.push_back(row["r"].get<double>());
     s.y.push_back(std::max(row["removed"].get<double>(), 0.5));
-    // time series of each r as its own CSV
+    // time series of each point as its own CSV; an r given more than once (seeds) adds the index
+    const double rv = row["r"].get<double>();
+    const bool repeated = std::count(r.cohesion_ratios.begin(), r.cohesion_ratios.end(), rv) > 1;
+    const std::string series_file = repeated ? fmt::format("reduction_r{:g}_i{}.csv", rv, rec.index) : fmt::format("reduction_r{:g}.csv", rv);
+    row["index"] = rec.index;
+    row["seed"] = rec.seed;
+    row["series_csv"] = (o.out / series_file).string();
     std::string ts = "time_s,front_m,back_m,size_m,particles\n";
     for (auto& e : row["series_t_front_back_size_n"]) ts += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{}\n", e[0].get<double>(), e[1].get<double>(), e[2].get<double>(), e[3].get<double>(), e[4].get<long>());
-    io::write_file_atomic(o.out / fmt::format("reduction_r{:g}.csv", row["r"].get<double>()), ts);
+    io::write_file_atomic(o.out / series_file, ts);
     row.erase("series_t_front_back_size_n");
     rows.push_back(row);
   }
