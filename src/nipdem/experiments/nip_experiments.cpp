@@ -40,7 +40,8 @@ void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment
       if (key_of(u) != key) continue;
       const auto hint = use_instead.find(key);
       throw_input("experiment " + experiment, "--set " + key, u.substr(std::min(u.size(), key.size() + 1)),
-                  "this experiment sets the key itself (" + f + ") and would replace the value",
+                  "this experiment sets the key itself (" + (f.substr(key.size()) == "=*" ? key + ", a new value for every run" : f) +
+                      ") and would replace the value",
                   hint != use_instead.end() ? "use " + hint->second + " instead" : "leave it out");
     }
   }
