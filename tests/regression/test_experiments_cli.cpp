@@ -86,6 +86,39 @@ TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
   fs::remove_all(d);
 }
 
+// A tiny clean-state run (colour, 400 um window, 1 ms): the front is reported with the window's
+// particle balance over its steady part. The counters obey conservation (particles at the end =
+// all inserted - all removed, at the last sample), and a window that takes in toner while
+// letting none out is flagged "filling" with a warning instead of passing as a steady state.
+TEST(ExperimentCli, TinyFrontPositionReportsTheWindowsParticleBalance) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_front_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const auto r = cli("experiment front-position --preset color --gap 100e-6 --set collision.stiffness_scale=0.01 "
+                     "--set inflow.layer_thickness_m=15e-6 --set geometry.window_x_min_m=-200e-6 "
+                     "--set geometry.window_x_max_m=200e-6 --min-time 8e-4 --max-time 1e-3 --quiet --json --out " + d.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["points"].size(), 1u);
+  const auto& p = j["points"][0];
+  const auto rj = nlohmann::json::parse(nipdem::io::read_file(d / "front_position" / "realizations" / "0.json"));
+  const auto& series = rj["result"]["series_t_front_back_m_in_out"];
+  ASSERT_GE(series.size(), 40u);
+  const auto& last = series.back();
+  EXPECT_NEAR(last[0].get<double>(), p["simulated_s"].get<double>(), 1e-12);
+  EXPECT_EQ(p["particles_at_end"].get<long>(), last[3].get<long>() - last[4].get<long>());  // conservation
+  ASSERT_TRUE(p["steady"].get<bool>()) << p.dump();
+  EXPECT_GT(p["inflow_steady"].get<long>(), 0);  // the drum keeps bringing toner
+  // 1 ms is far too short for the assembly to reach the window's end: nothing leaves but what
+  // the drum carries out at once, so the window is filling and says so
+  EXPECT_LT(p["outflow_over_inflow_steady"].get<double>(), 0.5);
+  EXPECT_TRUE(p["filling"].get<bool>());
+  EXPECT_EQ(j["n_filling"], 1);
+  EXPECT_NE(r.err.find("still filling"), std::string::npos) << r.err;
+  const auto csv = nipdem::io::read_file(d / "front_position.csv");
+  EXPECT_EQ(csv.rfind("gap_m,sleeve_speed_m_per_s,front_m,front_std_m,steady,outflow_over_inflow_steady\n", 0), 0u) << csv;
+  fs::remove_all(d);
+}
+
 // An r given twice is two seeds of one point: each keeps its own time series (the second used
 // to overwrite the first's reduction_r1.csv).
 TEST(ExperimentCli, RepeatedCohesionRatioKeepsEachSeedsSeries) {

@@ -92,3 +92,58 @@ TEST(AnalysisSteady, ShortSignalAndBadInput) {
   o.n_batches = 2;
   EXPECT_THROW(detect_steady_state({0, 1}, {1, 1}, o), InputError);
 }
+
+// Particle balance of an open region: a Poisson stream of rate lambda enters, each particle
+// stays exactly tau and leaves. Over [t0, T] with t0 >= tau the region is full: outflow equals
+// inflow up to the stream's shot noise (expected in and out differ by a few sqrt(lambda tau)).
+// From t0 = 0 it is filling for the first tau: outflow/inflow = (T - tau) / T.
+TEST(AnalysisFlowBalance, PoissonStreamWithFixedResidenceTime) {
+  const double lambda = 2e4, tau = 2e-3, T = 20e-3, dt = 1e-4;  // 20 per 0.1 ms, 40 inside
+  Rng r(17);
+  std::vector<double> arrivals;
+  for (double ta = 0.0;;) {
+    ta += -std::log(1.0 - r.uniform(0.0, 1.0)) / lambda;
+    if (ta > T) break;
+    arrivals.push_back(ta);
+  }
+  std::vector<double> t;
+  std::vector<std::int64_t> in, out;
+  for (int k = 0; k * dt <= T + 1e-12; ++k) {
+    const double now = k * dt;
+    t.push_back(now);
+    std::int64_t a = 0, l = 0;
+    for (double ta : arrivals) {
+      if (ta <= now) ++a;
+      if (ta + tau <= now) ++l;
+    }
+    in.push_back(a);
+    out.push_back(l);
+  }
+  const FlowBalance full = flow_balance(t, in, out, tau);
+  const double n = static_cast<double>(full.inflow);
+  EXPECT_NEAR(n, lambda * (T - tau), 4.0 * std::sqrt(lambda * (T - tau)));  // 4 sigma
+  // in - out over the full part = content(T) - content(tau), two nearly independent Poisson(40)
+  // counts (18 ms apart, residence 2 ms): std sqrt(2 lambda tau) ~ 8.9; 4 sigma
+  EXPECT_LE(std::abs(full.inflow - full.outflow), 4.0 * std::sqrt(2.0 * lambda * tau));
+  EXPECT_NEAR(full.outflow_over_inflow, 1.0, 4.0 * std::sqrt(2.0 * lambda * tau) / n);
+  EXPECT_NEAR(full.growth_per_s, 0.0, 4.0 * std::sqrt(2.0 * lambda * tau) / (T - tau));
+  const FlowBalance filling = flow_balance(t, in, out, 0.0);
+  // outflow / inflow from 0 = the fraction of the ~400 arrivals that came before T - tau:
+  // binomial, p = 0.9, std sqrt(p (1 - p) / 400) = 0.015; 4 sigma
+  const double p = (T - tau) / T;
+  EXPECT_NEAR(filling.outflow_over_inflow, p, 4.0 * std::sqrt(p * (1.0 - p) / static_cast<double>(filling.inflow)));
+  EXPECT_NEAR(filling.growth_per_s, lambda * tau / T, 4.0 * std::sqrt(lambda * tau) / T);
+  EXPECT_DOUBLE_EQ(filling.t_from, 0.0);
+  EXPECT_DOUBLE_EQ(filling.t_to, t.back());
+}
+
+TEST(AnalysisFlowBalance, EmptyStreamAndBadInput) {
+  const FlowBalance b = flow_balance({0.0, 1.0, 2.0}, {5, 5, 5}, {0, 0, 0}, 0.5);
+  EXPECT_EQ(b.inflow, 0);
+  EXPECT_TRUE(std::isnan(b.outflow_over_inflow));
+  EXPECT_DOUBLE_EQ(b.t_from, 1.0);
+  EXPECT_THROW(flow_balance({0.0, 1.0}, {0}, {0, 0}, 0.0), InputError);          // lengths
+  EXPECT_THROW(flow_balance({0.0, 1.0}, {3, 2}, {0, 0}, 0.0), InputError);       // count decreases
+  EXPECT_THROW(flow_balance({1.0, 0.0}, {0, 0}, {0, 0}, 0.0), InputError);       // time backwards
+  EXPECT_THROW(flow_balance({0.0, 1.0}, {0, 1}, {0, 0}, 2.0), InputError);       // nothing after t_from
+}

@@ -106,4 +106,31 @@ SteadyState detect_steady_state(const std::vector<double>& t, const std::vector<
   return s;
 }
 
+FlowBalance flow_balance(const std::vector<double>& t, const std::vector<std::int64_t>& cumulative_in,
+                         const std::vector<std::int64_t>& cumulative_out, double t_from) {
+  const std::string where = "flow balance";
+  if (t.size() != cumulative_in.size() || t.size() != cumulative_out.size())
+    throw_input(where, "counts", fmt::format("{} times, {} inflow, {} outflow counts", t.size(), cumulative_in.size(), cumulative_out.size()),
+                "lengths differ");
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    if (!(t[i] >= t[i - 1])) throw_input(where, fmt::format("t[{}]", i), fmt::format("{:g}", t[i]), "time goes backwards");
+    if (cumulative_in[i] < cumulative_in[i - 1] || cumulative_out[i] < cumulative_out[i - 1])
+      throw_input(where, fmt::format("sample {}", i), fmt::format("in {}, out {}", cumulative_in[i], cumulative_out[i]),
+                  "cumulative counts decrease");
+  }
+  std::size_t k = 0;
+  while (k < t.size() && t[k] < t_from) ++k;
+  if (k == t.size()) throw_input(where, "t_from", fmt::format("{:g}", t_from), "after the last sample");
+  const std::size_t last = t.size() - 1;
+  FlowBalance b;
+  b.t_from = t[k];
+  b.t_to = t[last];
+  b.inflow = cumulative_in[last] - cumulative_in[k];
+  b.outflow = cumulative_out[last] - cumulative_out[k];
+  b.outflow_over_inflow = b.inflow > 0 ? static_cast<double>(b.outflow) / static_cast<double>(b.inflow)
+                                       : std::numeric_limits<double>::quiet_NaN();
+  b.growth_per_s = b.t_to > b.t_from ? static_cast<double>(b.inflow - b.outflow) / (b.t_to - b.t_from) : 0.0;
+  return b;
+}
+
 }  // namespace nipdem::analysis

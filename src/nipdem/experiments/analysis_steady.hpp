@@ -16,6 +16,7 @@
 // deviation (the fluctuation), `stderr_mean` the batch-means standard error of that value.
 #pragma once
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -45,5 +46,20 @@ struct SteadyState {
 // (length mismatch, non-finite values, bad options); a signal that is too short is reported
 // as not steady.
 SteadyState detect_steady_state(const std::vector<double>& t, const std::vector<double>& y, const SteadyOptions& opt = {});
+
+// Particle balance of an open region (the nip window) over [t_from, last sample]: what came in
+// and what went out, from cumulative counts sampled at times t. A steady *signal* (the front)
+// does not make a steady *assembly*: while outflow/inflow is well below 1 the window is still
+// filling and a slow drift may follow (docs/analysis.md, "Filling").
+struct FlowBalance {
+  double t_from = 0, t_to = 0;         // the interval used [s] (t_from = first sample >= the request)
+  std::int64_t inflow = 0, outflow = 0;  // particles in / out over it
+  double outflow_over_inflow = 0;      // NaN when nothing came in
+  double growth_per_s = 0;             // (inflow - outflow) / (t_to - t_from); 0 for an empty interval
+};
+// `t` non-decreasing, `cumulative_in`/`cumulative_out` non-decreasing, all the same length;
+// throws InputError otherwise or when no sample lies at or after t_from.
+FlowBalance flow_balance(const std::vector<double>& t, const std::vector<std::int64_t>& cumulative_in,
+                         const std::vector<std::int64_t>& cumulative_out, double t_from);
 
 }  // namespace nipdem::analysis

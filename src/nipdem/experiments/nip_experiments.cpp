@@ -115,6 +115,10 @@ json failures(const ensemble::Summary& s) {
   return f;
 }
 
+// A steady front whose window takes in more than twice what it lets out is flagged "filling":
+// the assembly is still growing and the front may drift later (docs/analysis.md, "Filling").
+constexpr double kFillingBelow = 0.5;
+
 json meta(const ExperimentOptions& o) {
   return {{"git_hash", kGitHash}, {"preset", o.config.empty() ? o.preset : ""}, {"config", o.config}, {"set", o.sets},
           {"seed", o.seed}, {"jobs", o.jobs}, {"mpi", o.mpi}};
@@ -148,6 +152,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     sets.push_back("run.seed=" + std::to_string(seed % (1ULL << 62)));
     NipRun run(experiment_config(o, sets));
     std::vector<double> t, front, back;
+    std::vector<std::int64_t> cum_in, cum_out;  // particles in / out of the window so far
     analysis::SteadyState st;
     analysis::ExtentOptions eo{analysis::FrontAt::min_x, 3, 0.02};  // ignore a few stray particles
     const double h = 0.5 * run.config().gap;
@@ -159,6 +164,8 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
       if (xs.size() < 8) continue;  // no assembly (yet)
       const auto e = analysis::assembly_extent(run.sim().time(), xs, eo);
       t.push_back(e.t); front.push_back(e.front); back.push_back(e.back);
+      cum_in.push_back(run.inserted());
+      cum_out.push_back(run.removed(Exit::developed) + run.removed(Exit::returned) + run.removed(Exit::lost));
       if (run.sim().time() >= f.min_time_s && t.size() >= 40 && t.size() % 10 == 0) {
         st = analysis::detect_steady_state(t, front);
         if (st.steady) break;
@@ -166,22 +173,41 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     }
     if (t.size() >= 40) st = analysis::detect_steady_state(t, front);
     json series = json::array();
-    for (std::size_t k = 0; k < t.size(); ++k) series.push_back({t[k], front[k], back[k]});
-    return json{{"gap_m", points[i].first}, {"sleeve_speed_m_per_s", run.config().roller_speed},
-                {"front_m", st.value}, {"front_std_m", st.std}, {"front_stderr_m", st.stderr_mean},
-                {"steady", st.steady}, {"not_steady_reason", st.reason}, {"t_onset_s", st.t_onset},
-                {"simulated_s", run.sim().time()}, {"series_t_front_back_m", series}};
+    for (std::size_t k = 0; k < t.size(); ++k) series.push_back({t[k], front[k], back[k], cum_in[k], cum_out[k]});
+    json res{{"gap_m", points[i].first}, {"sleeve_speed_m_per_s", run.config().roller_speed},
+             {"front_m", st.value}, {"front_std_m", st.std}, {"front_stderr_m", st.stderr_mean},
+             {"steady", st.steady}, {"not_steady_reason", st.reason}, {"t_onset_s", st.t_onset},
+             {"simulated_s", run.sim().time()}, {"particles_at_end", run.sim().bodies().x.size()},
+             {"series_t_front_back_m_in_out", series}};
+    // Is the window still filling over the steady part? (docs/analysis.md, "Filling")
+    if (st.steady) {
+      const auto fb = analysis::flow_balance(t, cum_in, cum_out, st.t_onset);
+      res["inflow_steady"] = fb.inflow;
+      res["outflow_steady"] = fb.outflow;
+      res["outflow_over_inflow_steady"] = std::isfinite(fb.outflow_over_inflow) ? json(fb.outflow_over_inflow) : json(nullptr);
+      res["filling"] = fb.inflow > 0 && fb.outflow_over_inflow < kFillingBelow;
+    }
+    return res;
   };
   const auto sum = ensemble::run(task, ens(o, points.size(), "front_position"));
   if (!sum.is_root) return {};
   json rows = json::array();
-  std::string csv = "gap_m,sleeve_speed_m_per_s,front_m,front_std_m,steady\n";
+  std::string csv = "gap_m,sleeve_speed_m_per_s,front_m,front_std_m,steady,outflow_over_inflow_steady\n";
   std::map<double, io::Series> by_speed;
+  int n_filling = 0;
   for (const auto& r : sum.records) {
     if (!r.ok) continue;
     json row = r.result;
-    csv += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{}\n", row["gap_m"].get<double>(), row["sleeve_speed_m_per_s"].get<double>(),
-                       row["front_m"].get<double>(), row["front_std_m"].get<double>(), row["steady"].get<bool>() ? 1 : 0);
+    const auto ratio = row.value("outflow_over_inflow_steady", json(nullptr));
+    csv += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{},{}\n", row["gap_m"].get<double>(), row["sleeve_speed_m_per_s"].get<double>(),
+                       row["front_m"].get<double>(), row["front_std_m"].get<double>(), row["steady"].get<bool>() ? 1 : 0,
+                       ratio.is_number() ? fmt::format("{:.3g}", ratio.get<double>()) : std::string("nan"));
+    if (row.value("filling", false))
+      std::fprintf(stderr,
+                   "nipdem: warning: front-position: gap %g um, %.3g m/min: the front is steady but the window is still filling "
+                   "(outflow/inflow = %.2f over the steady part); the front may still drift: try a larger --min-time\n",
+                   row["gap_m"].get<double>() * 1e6, row["sleeve_speed_m_per_s"].get<double>() * 60.0, ratio.get<double>());
+    if (row.value("filling", false)) ++n_filling;
     const double v = row["sleeve_speed_m_per_s"].get<double>();
     auto& s = by_speed[v];
     s.label = fmt::format("v_h = {:.3g} m/min", v * 60);
@@ -189,7 +215,8 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     s.x.push_back(row["gap_m"].get<double>() * 1e6);
     s.y.push_back(row["front_m"].get<double>() * 1e6);
     s.y_err.push_back(row["front_std_m"].get<double>() * 1e6);
-    row.erase("series_t_front_back_m");
+    row.erase("series_t_front_back_m_in_out");
+    row.erase("series_t_front_back_m");  // realizations written before the in/out counts
     rows.push_back(row);
   }
   io::write_file_atomic(o.out / "front_position.csv", csv);
@@ -200,6 +227,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
   for (auto& [v, s] : by_speed) plot.series.push_back(s);
   if (!plot.series.empty() && !plot.series[0].x.empty()) io::write_plot_png(o.out / "front_position.png", plot);
   return {{"experiment", "front-position"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
+          {"n_filling", n_filling},
           {"csv", (o.out / "front_position.csv").string()}, {"plot", (o.out / "front_position.png").string()}, {"meta", meta(o)}};
 }
 
