@@ -202,12 +202,13 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     csv += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{},{}\n", row["gap_m"].get<double>(), row["sleeve_speed_m_per_s"].get<double>(),
                        row["front_m"].get<double>(), row["front_std_m"].get<double>(), row["steady"].get<bool>() ? 1 : 0,
                        ratio.is_number() ? fmt::format("{:.3g}", ratio.get<double>()) : std::string("nan"));
-    if (row.value("filling", false))
+    if (row.value("filling", false)) {
+      ++n_filling;
       std::fprintf(stderr,
                    "nipdem: warning: front-position: gap %g um, %.3g m/min: the front is steady but the window is still filling "
                    "(outflow/inflow = %.2f over the steady part); the front may still drift: try a larger --min-time\n",
                    row["gap_m"].get<double>() * 1e6, row["sleeve_speed_m_per_s"].get<double>() * 60.0, ratio.get<double>());
-    if (row.value("filling", false)) ++n_filling;
+    }
     const double v = row["sleeve_speed_m_per_s"].get<double>();
     auto& s = by_speed[v];
     s.label = fmt::format("v_h = {:.3g} m/min", v * 60);
