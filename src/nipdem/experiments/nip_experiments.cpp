@@ -130,7 +130,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
   if (f.gaps_m.empty()) throw_input("experiment front-position", "--gap", "", "need at least one gap");
   for (double g : f.gaps_m) require_range("experiment front-position", "--gap", g, 20e-6, 5e-3);
   for (double v : f.sleeve_speeds_m_per_min) require_range("experiment front-position", "--sleeve-speed", v, 0.0, 1000.0);
-  if (!(f.max_time_s >= f.min_time_s)) throw_input("experiment front-position", "max_time_s", num(f.max_time_s), "must be >= min_time_s");
+  if (!(f.max_time_s >= f.min_time_s)) throw_input("experiment front-position", "--max-time", num(f.max_time_s), "must not be below --min-time", fmt::format("[{:g}, inf)", f.min_time_s));
   std::vector<std::pair<double, double>> points;  // (gap, speed m/s; <0 = preset)
   const std::vector<double> speeds = f.sleeve_speeds_m_per_min.empty() ? std::vector<double>{-1.0} : f.sleeve_speeds_m_per_min;
   for (double v : speeds) for (double g : f.gaps_m) points.emplace_back(g, v < 0 ? -1.0 : v / 60.0);
