@@ -144,7 +144,30 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--pile-width", k->reduction.pile_width_m, "initial assembly width [m]")->capture_default_str();
     sub->add_option("--pile-height", k->reduction.pile_height_m, "initial assembly height [m]")->capture_default_str();
     sub->add_option("--pits", k->reduction.pits, "sleeve pits entering upstream: empty (clean sleeve), filled, or preset")->capture_default_str();
-    sub->callback([=] { finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion(c->o, *k); }); });
+    auto sweep = std::make_shared<std::string>();
+    auto range = std::make_shared<std::string>();
+    sub->add_option("--from-sweep", *sweep, "no runs: fit r to the removed counts of a finished `experiment reduction` JSON (seeds = repeated r; docs/reduction.md)");
+    sub->add_option("--target-range", *range, "with --from-sweep: LO:HI of the measured speed [m/s] (Table 4.3's three experiments: black 7.4e-4:7.8e-4, colour 2.0e-4:2.9e-4)");
+    sub->callback([=] {
+      if (sweep->empty()) {
+        if (!range->empty()) nipdem::throw_input("calibrate cohesion", "--target-range", *range, "only with --from-sweep");
+        finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion(c->o, *k); });
+        return;
+      }
+      nipdem::calibrate::CountTarget t;
+      t.speed = t.speed_lo = t.speed_hi = k->target_speed_m_per_s;
+      t.time_s = k->reduction.time_s;
+      t.pile_width_m = k->reduction.pile_width_m;
+      if (!range->empty()) {
+        const auto colon = range->find(':');
+        std::vector<double> v;
+        if (colon != std::string::npos) v = parse_list(range->substr(0, colon) + "," + range->substr(colon + 1), "--target-range");
+        if (v.size() != 2) nipdem::throw_input("calibrate cohesion", "--target-range", *range, "expected LO:HI in m/s");
+        t.speed_lo = v[0];
+        t.speed_hi = v[1];
+      }
+      finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion_from_sweep(c->o, *sweep, t); });
+    });
   }
 });
 }  // namespace

@@ -124,3 +124,80 @@ TEST(CohesionSearch, StopsAfterRoundZeroWhenNotBracketed) {
   EXPECT_FALSE(s.fit.bracketed);
   EXPECT_EQ(s.rounds_r.size(), 1u);
 }
+
+// ---- r from the removed counts of a sweep (docs/reduction.md) ----
+namespace {
+// fig. 4.25's shape as the thesis describes it: linear fall from N0 at r = 0 to zero at r = 1
+double fig425(double r, double n0) { return n0 * std::max(0.0, 1.0 - r); }
+}  // namespace
+
+TEST(CohesionCounts, TargetCountIsTheSpeedTimesTheLinearDensityOfThePile) {
+  // 600 toner over 400 um: 1.5 per um; 0.76 mm/s over 100 ms = 76 um -> 114 toner (the thesis's
+  // own conversion of Table 4.3 into "fewer than 200")
+  std::vector<CountPoint> p{{0.0, 500, 600}, {2.0, 0, 600}};
+  CountTarget t{7.6e-4, 7.4e-4, 7.8e-4, 0.1, 400e-6};
+  const auto f = fit_cohesion_from_counts(p, t);
+  EXPECT_NEAR(f.target, 114.0, 1e-9);
+  EXPECT_NEAR(f.target_lo, 111.0, 1e-9);
+  EXPECT_NEAR(f.target_hi, 117.0, 1e-9);
+  ASSERT_TRUE(f.bracketed);
+  EXPECT_NEAR(f.r_fit, 2.0 * (500.0 - 114.0) / 500.0, 1e-12);  // linear between the two points
+}
+
+TEST(CohesionCounts, RecoversTheRootOfTheLinearFallFromNoisySeeds) {
+  // 4 seeds per r with Gaussian scatter of 15 toner (the scatter seen between seeds of the
+  // 10 ms screens); the truth r* solves N0 (1 - r*) = target. Over 40 synthetic sweeps the
+  // 1-sigma interval must contain r* in most of them (the interval is built from the mean's
+  // standard error at each r: ~68 % coverage expected; we require >= 50 % and the fit within
+  // 0.1 of r* every time, 0.1 = 6 standard errors of the mean curve's crossing).
+  const double n0 = 400.0, target = 114.0, rstar = 1.0 - target / n0;
+  const std::vector<double> rs{0, 0.25, 0.5, 0.75, 1, 1.5, 2, 3};
+  std::uint64_t state = 12345;
+  auto normal = [&] {  // Box-Muller on a 64-bit LCG: deterministic
+    auto u = [&] { state = state * 6364136223846793005ULL + 1442695040888963407ULL; return ((state >> 11) + 0.5) * 0x1.0p-53; };
+    return std::sqrt(-2.0 * std::log(u())) * std::cos(6.283185307179586 * u());
+  };
+  int covered = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<CountPoint> p;
+    for (double r : rs)
+      for (int s = 0; s < 4; ++s) p.push_back({r, fig425(r, n0) + 15.0 * normal(), 600.0});
+    const auto f = fit_cohesion_from_counts(p, {7.6e-4, 7.6e-4, 7.6e-4, 0.1, 400e-6});
+    ASSERT_TRUE(f.bracketed);
+    EXPECT_NEAR(f.r_fit, rstar, 0.1);
+    ASSERT_TRUE(f.in_band);
+    if (f.r_lo <= rstar && rstar <= f.r_hi) ++covered;
+    EXPECT_FALSE(f.single_seed);
+  }
+  EXPECT_GE(covered, 20);
+}
+
+TEST(CohesionCounts, ReportsWhenTheTargetIsOutsideTheSweep) {
+  std::vector<CountPoint> p{{0.0, 10, 600}, {1.0, 5, 600}, {1.0, 7, 600}};
+  const auto f = fit_cohesion_from_counts(p, {7.6e-4, 7.6e-4, 7.6e-4, 0.1, 400e-6});
+  EXPECT_FALSE(f.bracketed);
+  EXPECT_NE(f.hint.find("smaller r"), std::string::npos);
+  EXPECT_TRUE(f.single_seed);  // r = 0 has one seed
+  ASSERT_EQ(f.rows.size(), 2u);
+  EXPECT_DOUBLE_EQ(f.rows[1].mean, 6.0);
+  EXPECT_NEAR(f.rows[1].stderr_, 1.0, 1e-12);  // sd sqrt(2) over sqrt(2)
+}
+
+TEST(CohesionCounts, BadInputIsRefusedNamingTheKey) {
+  const CountTarget t{7.6e-4, 7.4e-4, 7.8e-4, 0.1, 400e-6};
+  auto msg = [&](std::vector<CountPoint> p, CountTarget tt) {
+    try {
+      fit_cohesion_from_counts(p, tt);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(msg({{1.0, 5, 600}, {1.0, 6, 600}}, t).find("distinct r"), std::string::npos);
+  EXPECT_NE(msg({{-1.0, 5, 600}, {1.0, 6, 600}}, t).find("r"), std::string::npos);
+  EXPECT_NE(msg({{0.0, NAN, 600}, {1.0, 6, 600}}, t).find("removed"), std::string::npos);
+  EXPECT_NE(msg({{0.0, 5, 0}, {1.0, 6, 600}}, t).find("initial_particles"), std::string::npos);
+  CountTarget bad = t;
+  bad.speed_lo = 9e-4;  // above the speed
+  EXPECT_NE(msg({{0.0, 5, 600}, {1.0, 6, 600}}, bad).find("--target-range"), std::string::npos);
+}

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -111,6 +112,173 @@ CohesionSearch search_cohesion_ratio(const SpeedEvaluator& evaluate, const Cohes
   }
   std::sort(out.points.begin(), out.points.end(), [](const SpeedPoint& a, const SpeedPoint& b) { return a.r < b.r; });
   return out;
+}
+
+CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const CountTarget& t) {
+  for (const auto& p : points) {
+    if (!std::isfinite(p.r) || p.r < 0.0) throw_input(kWhere, "r", fmt::format("{:g}", p.r), "must be finite and >= 0");
+    if (!std::isfinite(p.removed)) throw_input(kWhere, "removed", fmt::format("{:g} at r = {:g}", p.removed, p.r), "must be finite");
+    if (!std::isfinite(p.initial) || p.initial <= 0.0) throw_input(kWhere, "initial_particles", fmt::format("{:g} at r = {:g}", p.initial, p.r), "must be > 0");
+  }
+  require_range(kWhere, "--target-speed", t.speed, 0.0, 10.0);
+  require_range(kWhere, "--target-range (low)", t.speed_lo, 0.0, t.speed);
+  require_range(kWhere, "--target-range (high)", t.speed_hi, t.speed, 10.0);
+  require_range(kWhere, "time_s", t.time_s, 1e-6, 10.0);
+  require_range(kWhere, "--pile-width", t.pile_width_m, 1e-6, 1e-1);
+  std::map<double, std::vector<double>> by_r;
+  double n0 = 0.0;
+  for (const auto& p : points) {
+    by_r[p.r].push_back(p.removed);
+    n0 += p.initial;
+  }
+  if (by_r.size() < 2) throw_input(kWhere, "points", std::to_string(by_r.size()) + " distinct r", "need at least two distinct r");
+  CountFit f;
+  f.n0 = n0 / double(points.size());
+  const double per_speed = t.time_s * f.n0 / t.pile_width_m;  // toner per (m/s)
+  f.target = t.speed * per_speed;
+  f.target_lo = t.speed_lo * per_speed;
+  f.target_hi = t.speed_hi * per_speed;
+  for (const auto& [r, v] : by_r) {
+    CountRow row{r, v.size(), 0.0, 0.0};
+    for (double x : v) row.mean += x;
+    row.mean /= double(v.size());
+    if (v.size() > 1) {
+      double ss = 0.0;
+      for (double x : v) ss += (x - row.mean) * (x - row.mean);
+      row.stderr_ = std::sqrt(ss / double(v.size() - 1) / double(v.size()));
+    } else {
+      f.single_seed = true;
+    }
+    f.rows.push_back(row);
+  }
+  // crossings of the mean curve (linear between swept r) with the target
+  const auto& R = f.rows;
+  for (std::size_t i = 0; i + 1 < R.size(); ++i) {
+    const double a = R[i].mean - f.target, b = R[i + 1].mean - f.target;
+    if (a == 0.0 && i > 0) continue;  // counted as the previous segment's end
+    if ((a <= 0.0 && b >= 0.0) || (a >= 0.0 && b <= 0.0)) {
+      if (!f.bracketed) f.r_fit = a == b ? R[i].r : R[i].r + (R[i + 1].r - R[i].r) * a / (a - b);
+      f.bracketed = true;
+      ++f.crossings;
+    }
+  }
+  // 1-sigma interval: every r (fine grid, mean and stderr linear between swept r) at which
+  // [mean - stderr, mean + stderr] overlaps [target_lo, target_hi]
+  const int kGrid = 4000;
+  const double r0 = R.front().r, r1 = R.back().r;
+  std::size_t seg = 0;
+  for (int k = 0; k <= kGrid; ++k) {
+    const double r = k == kGrid ? r1 : r0 + (r1 - r0) * double(k) / kGrid;
+    while (seg + 2 < R.size() && r > R[seg + 1].r) ++seg;
+    const double w = (r - R[seg].r) / (R[seg + 1].r - R[seg].r);
+    const double m = R[seg].mean + w * (R[seg + 1].mean - R[seg].mean);
+    const double e = R[seg].stderr_ + w * (R[seg + 1].stderr_ - R[seg].stderr_);
+    if (m - e <= f.target_hi && m + e >= f.target_lo) {
+      if (!f.in_band) f.r_lo = r;
+      f.in_band = true;
+      f.r_hi = r;
+    }
+  }
+  if (f.in_band) {
+    f.open_lo = f.r_lo <= r0;
+    f.open_hi = f.r_hi >= r1;
+  }
+  if (!f.bracketed) {
+    const bool above = R.front().mean > f.target;
+    f.hint = above ? "every mean count is above the target: extend the sweep to larger r" : "every mean count is below the target: extend the sweep to smaller r";
+  }
+  return f;
+}
+
+json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& file, const CountTarget& target) {
+  json rep;
+  try {
+    rep = json::parse(io::read_file(file));
+  } catch (const json::exception& e) {
+    throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
+  }
+  if (!rep.is_object() || rep.value("experiment", std::string()) != "reduction" || !rep.contains("points") || !rep["points"].is_array())
+    throw_input(file, "experiment", "", "expected the JSON written by `nipdem experiment reduction` (\"experiment\": \"reduction\", \"points\": [...])");
+  std::vector<CountPoint> pts;
+  double T = -1.0;
+  std::size_t k = 0;
+  for (const auto& p : rep["points"]) {
+    for (const char* key : {"r", "removed", "initial_particles", "time_s"})
+      if (!p.contains(key) || !p[key].is_number()) throw_input(file, fmt::format("points[{}].{}", k, key), "", "missing or not a number");
+    const double tk = p["time_s"].get<double>();
+    if (T < 0.0) T = tk;
+    if (std::abs(tk - T) > 1e-6 * T) throw_input(file, fmt::format("points[{}].time_s", k), fmt::format("{:g}", tk), fmt::format("every point must have the same observation time ({:g} s)", T));
+    pts.push_back({p["r"].get<double>(), p["removed"].get<double>(), p["initial_particles"].get<double>()});
+    ++k;
+  }
+  CountTarget t = target;
+  t.time_s = T > 0.0 ? T : t.time_s;
+  if (rep.contains("pile_width_m") && rep["pile_width_m"].is_number()) t.pile_width_m = rep["pile_width_m"].get<double>();
+  const CountFit f = fit_cohesion_from_counts(pts, t);
+
+  std::string csv = "r,seeds,removed_mean,removed_stderr\n";
+  io::Series s, raw;
+  s.label = "mean over seeds (± standard error)";
+  s.markers = true;
+  s.line = false;
+  raw.label = "each seed";
+  raw.markers = true;
+  raw.line = false;
+  raw.marker_size = 2.5;
+  for (const auto& row : f.rows) {
+    csv += fmt::format("{:.8g},{},{:.8g},{:.8g}\n", row.r, row.n, row.mean, row.stderr_);
+    s.x.push_back(row.r);
+    s.y.push_back(row.mean);
+    s.y_err.push_back(row.stderr_);
+  }
+  for (const auto& p : pts) {
+    raw.x.push_back(p.r);
+    raw.y.push_back(p.removed);
+  }
+  io::write_file_atomic(o.out / "cohesion.csv", csv);
+  io::PlotSpec plot;
+  plot.title = "Cohesion ratio from removed toner (§4.6, fig. 4.25, Table 4.3)";
+  plot.x_label = "r = F_coh / F_adh";
+  plot.y_label = fmt::format("toner removed in {:g} ms", 1e3 * t.time_s);
+  plot.series.push_back(raw);
+  plot.series.push_back(s);
+  const double xa = f.rows.front().r, xb = f.rows.back().r;
+  for (auto [y, lab] : {std::pair{f.target, "Table 4.3 speed as a count"}, std::pair{f.target_lo, "its range"}, std::pair{f.target_hi, ""}}) {
+    io::Series tl;
+    tl.label = lab;
+    tl.x = {xa, xb};
+    tl.y = {y, y};
+    tl.dashed = true;
+    plot.series.push_back(tl);
+  }
+  io::write_plot_png(o.out / "cohesion.png", plot);
+
+  json rows = json::array();
+  for (const auto& row : f.rows) rows.push_back({{"r", row.r}, {"seeds", row.n}, {"removed_mean", row.mean}, {"removed_stderr", row.stderr_}});
+  json j{{"calibration", "cohesion"},
+         {"method", "counts from a reduction sweep"},
+         {"sweep", file},
+         {"target_speed_m_per_s", t.speed},
+         {"target_speed_range_m_per_s", {t.speed_lo, t.speed_hi}},
+         {"observation_time_s", t.time_s},
+         {"pile_width_m", t.pile_width_m},
+         {"initial_pile_mean", f.n0},
+         {"target_removed", f.target},
+         {"target_removed_range", {f.target_lo, f.target_hi}},
+         {"rows", rows},
+         {"bracketed", f.bracketed},
+         {"crossings", f.crossings},
+         {"single_seed_rows", f.single_seed},
+         {"csv", (o.out / "cohesion.csv").string()},
+         {"plot", (o.out / "cohesion.png").string()},
+         {"meta", {{"git_hash", kGitHash}}}};
+  if (f.bracketed) j["r_fit"] = f.r_fit;
+  else j["hint"] = f.hint;
+  if (f.in_band) {
+    j["r_1sigma"] = {f.r_lo, f.r_hi};
+    j["r_1sigma_open"] = {f.open_lo, f.open_hi};
+  }
+  return j;
 }
 
 json calibrate_cohesion(const experiments::ExperimentOptions& o, const CohesionOptions& c) {

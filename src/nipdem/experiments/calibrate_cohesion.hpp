@@ -71,6 +71,50 @@ struct CohesionOptions {
 // The search of steps 1-4 on any evaluator (tested on analytic v(r)).
 CohesionSearch search_cohesion_ratio(const SpeedEvaluator& evaluate, const CohesionOptions& c);
 
+// ---- r from the removal counts of a finished sweep (the thesis's own reading of §4.6) ----
+// Table 4.3 gives size-reduction speeds; the thesis turns them into counts of removed toner per
+// 100 ms ("less than 200 black, 70 colour"). We do the same for the simulated pile: a pile of
+// n0 toner over a width W at full height loses n0/W toner per metre it shrinks, so a speed v
+// over the observation time T is N = v T n0 / W toner (docs/reduction.md). The sweep gives
+// removed(r) at each r over seeds; r is where the mean curve (linear between the swept r)
+// meets N, and the 1-sigma interval is every r at which mean +- standard error (over seeds)
+// reaches the target band [N(v_lo), N(v_hi)] (Table 4.3's three experiments).
+struct CountPoint {
+  double r = 0;            // cohesion ratio [-], >= 0
+  double removed = 0;      // toner removed in the observation time
+  double initial = 0;      // toner in the pile at the start
+};
+struct CountTarget {
+  double speed = 0, speed_lo = 0, speed_hi = 0;  // measured size-reduction speed and its range [m/s]
+  double time_s = 0.1;                            // observation time of the sweep [s]
+  double pile_width_m = 400e-6;                   // initial pile width [m]
+};
+struct CountRow {
+  double r = 0;
+  std::size_t n = 0;       // seeds at this r
+  double mean = 0, stderr_ = 0;  // removed: mean and standard error over seeds (0 for one seed)
+};
+struct CountFit {
+  std::vector<CountRow> rows;            // sorted by r
+  double n0 = 0;                         // mean initial pile
+  double target = 0, target_lo = 0, target_hi = 0;  // removed toner the speeds imply
+  bool bracketed = false;                // the mean curve meets the target inside the sweep
+  double r_fit = 0;                      // lowest crossing of the mean curve
+  std::size_t crossings = 0;
+  bool in_band = false;                  // some r has mean +- stderr inside the target band
+  double r_lo = 0, r_hi = 0;             // 1-sigma interval (smallest / largest r in band)
+  bool open_lo = false, open_hi = false; // the interval reaches the end of the sweep
+  bool single_seed = false;              // some r has one seed only (no error estimate there)
+  std::string hint;
+};
+// Throws InputError for fewer than two distinct r, negative/non-finite values, or a bad target.
+CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const CountTarget& target);
+
+// `calibrate cohesion --from-sweep FILE`: reads an `experiment reduction` JSON, fits, writes
+// OUT/cohesion.{csv,png} and returns the report (no simulation is run).
+nlohmann::json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& sweep_json,
+                                             const CountTarget& target);
+
 // Runs the rounds (threads only: each round depends on the last) and returns the JSON report
 // (CLI.md keys: r_fit, bracket, points, rounds, ...). Writes OUT/cohesion.csv and
 // OUT/cohesion.png (speed vs r with the target).
