@@ -120,6 +120,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
   auto* exp = nipdem::cli::group(app, "experiment", "Run experiments of the thesis");
   auto* sub = exp->add_subcommand(
       "selftest", "Test harness of the ensemble machinery (threads, MPI, resume) with seeded random walks");
+  sub->group("");  // a test harness: hidden from the user's help (it still runs, with its own --help)
   auto o = std::make_shared<Opts>();
   sub->add_option("--realizations", o->realizations, "number of realizations")->capture_default_str()->check(CLI::PositiveNumber);
   sub->add_option("--jobs", o->jobs, "threads (per MPI rank)")->capture_default_str()->check(CLI::PositiveNumber);

@@ -10,8 +10,9 @@
 //      domain and a distance > safety_m from Γ (eq. 3.2.8);
 //   4. stop when max|Δg_k| and the change of u^H on every Γ are below tolerance × potential scale.
 //
-// The solver sees particles only through Disc (position, radius, charge per unit length), so the
-// DEM can call it as `electric.model = "ldc"`. Consecutive solve() calls with the same number of
+// The solver sees particles only through Disc (position, radius, charge per unit length). It is
+// not coupled to the DEM: the nip's electric force uses the sphere-plate model (docs/electric.md);
+// coupling LDC into the time loop would be its own piece of work (docs/ldc.md). Consecutive solve() calls with the same number of
 // discs warm-start from the previous potentials, coarse solution and defect.
 #pragma once
 #include <memory>
