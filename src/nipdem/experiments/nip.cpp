@@ -59,7 +59,13 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   geometry::Wall drum = cylinder("di_drum", drum_centre(), cfg_.drum_radius, cfg_.drum_speed, 2);
   sim_ = std::make_unique<engine::Simulation>(p, std::vector<geometry::Wall>{roller, drum});
   cfg_.magnet.threads = cfg_.threads;
-  if (auto field = make_magnet_field(cfg_.magnet)) sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
+  if (auto field = make_magnet_field(cfg_.magnet)) {
+    // the field must be valid wherever a toner centre can go (refused at setup, not mid-run)
+    const ReachableRegion reach{cfg_.x_min, cfg_.x_max, roller_centre(), drum_centre(), cfg_.roller_radius, cfg_.drum_radius,
+                                cfg_.roughness ? cfg_.rough_height : 0.0};
+    check_field_region(*field, reach, fmt::format("{} (magnet.field = \"{}\")", cfg_.file.empty() ? "config" : cfg_.file, cfg_.magnet.field));
+    sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
+  }
   if (cfg_.electric.enabled) {
     electric_ = std::make_shared<ElectricForce>(sim_.get(), cfg_.electric);
     sim_->add_force(electric_);

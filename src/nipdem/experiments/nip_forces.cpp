@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_map>
+
+#include <fmt/format.h>
 
 #include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/error.hpp"
@@ -32,12 +35,20 @@ MagnetForce::MagnetForce(std::shared_ptr<const magnet::MagnetField> field, Magne
 
 // Field at p: from the tile containing p (built on first use), or from the source itself
 // outside the tiled region (|x| > 12.8 mm or |y| > 6.4 mm) or for a field map.
-magnet::Sample MagnetForce::field_at(Vec2 p) {
-  const magnet::MagnetField* t = tile_for(p);
-  return t ? t->at(p) : field_->at(p);
+magnet::Sample MagnetForce::field_at(Vec2 p) { return sample(tile_for(p), p); }
+
+magnet::Sample MagnetForce::sample(const Tile* t, Vec2 p) const {
+  if (!t || !t->map) return field_->at(p);
+  if (!t->exact_cell.empty()) {
+    // the cell of p (rounding at the tile's edge stays in the tile)
+    const int i = std::clamp(static_cast<int>(std::floor((p.x - t->x0) / kTileH)), 0, kTileCells - 1);
+    const int j = std::clamp(static_cast<int>(std::floor((p.y - t->y0) / kTileH)), 0, kTileCells - 1);
+    if (t->exact_cell[static_cast<std::size_t>(j) * kTileCells + i]) return field_->at(p);
+  }
+  return t->map->at(p);
 }
 
-const magnet::MagnetField* MagnetForce::tile_for(Vec2 p) {
+const MagnetForce::Tile* MagnetForce::tile_for(Vec2 p) {
   if (!tabulate_) return nullptr;
   constexpr double T = kTileH * kTileCells;
   const double fx = std::floor(p.x / T) + kTilesX / 2, fy = std::floor(p.y / T) + kTilesY / 2;
@@ -51,6 +62,9 @@ const magnet::MagnetField* MagnetForce::tile_for(Vec2 p) {
     const int n = kTileCells + 1 + 4;
     const long gx0 = static_cast<long>(tx - kTilesX / 2) * kTileCells - 2;
     const long gy0 = static_cast<long>(ty - kTilesY / 2) * kTileCells - 2;
+    auto t = std::make_unique<Tile>();
+    t->x0 = static_cast<double>(gx0 + 2) * kTileH;
+    t->y0 = static_cast<double>(gy0 + 2) * kTileH;
     std::vector<double> bx, by;
     bx.reserve(static_cast<std::size_t>(n) * n);
     by.reserve(static_cast<std::size_t>(n) * n);
@@ -63,9 +77,21 @@ const magnet::MagnetField* MagnetForce::tile_for(Vec2 p) {
         finite = finite && std::isfinite(s.B.x) && std::isfinite(s.B.y);
       }
     // A node on a magnet corner (log singularity, inside the roller): keep the exact source there.
-    if (!finite) tile = field_;
-    else tile = std::make_shared<io::FieldMap>(static_cast<double>(gx0) * kTileH, static_cast<double>(gy0) * kTileH, kTileH,
-                                          kTileH, n, n, std::move(bx), std::move(by), "tile of " + field_->describe());
+    if (finite) {
+      t->map = std::make_shared<io::FieldMap>(static_cast<double>(gx0) * kTileH, static_cast<double>(gy0) * kTileH, kTileH,
+                                              kTileH, n, n, std::move(bx), std::move(by), "tile of " + field_->describe());
+      // Cells whose stencil (nodes i-2 .. i+3) meets a magnet face: the field jumps there and the
+      // interpolant would smear the jump over the stencil (up to 400x wrong, issue 18).
+      if (!field_->smooth_in({t->x0 - 2 * kTileH, t->y0 - 2 * kTileH}, {t->x0 + (kTileCells + 2) * kTileH, t->y0 + (kTileCells + 2) * kTileH})) {
+        t->exact_cell.assign(static_cast<std::size_t>(kTileCells) * kTileCells, 0);
+        for (int j = 0; j < kTileCells; ++j)
+          for (int i = 0; i < kTileCells; ++i) {
+            const Vec2 lo{t->x0 + (i - 2) * kTileH, t->y0 + (j - 2) * kTileH}, hi{t->x0 + (i + 3) * kTileH, t->y0 + (j + 3) * kTileH};
+            t->exact_cell[static_cast<std::size_t>(j) * kTileCells + i] = field_->smooth_in(lo, hi) ? 0 : 1;
+          }
+      }
+    }
+    tile = std::move(t);
   }
   return tile.get();
 }
@@ -107,8 +133,7 @@ void MagnetForce::field_pass(const BodyStore& b) {
 #pragma omp parallel for schedule(static) num_threads(nt)
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 p{b.x[i], b.y[i]};
-    const magnet::MagnetField* t = tile_for(p);  // exists now: no write
-    const magnet::Sample s = t ? t->at(p) : field_->at(p);
+    const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
     moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
     const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
     ffx_[i] = f.x;
@@ -259,6 +284,63 @@ void ElectricForce::add(const BodyStore& b, const DiscStore& d, double t, std::s
     fx[i] += f * n.x;
     fy[i] += f * n.y;
     torque[i] += d.wx[k] * f * n.y - d.wy[k] * f * n.x;  // applied at the nearest disc
+  }
+}
+
+}  // namespace nipdem::experiments
+
+namespace nipdem::experiments {
+
+double ReachableRegion::y_low(double x) const {
+  const double dx = x - roller_centre.x;
+  return roller_centre.y + std::sqrt(std::max(0.0, roller_radius * roller_radius - dx * dx)) - pit_depth;
+}
+double ReachableRegion::y_high(double x) const {
+  const double dx = x - drum_centre.x;
+  return drum_centre.y - std::sqrt(std::max(0.0, drum_radius * drum_radius - dx * dx));
+}
+
+void check_field_region(const magnet::MagnetField& f, const ReachableRegion& r, const std::string& field_name) {
+  const std::string window = fmt::format("[{:.4g}, {:.4g}] mm", 1e3 * r.x_min, 1e3 * r.x_max);
+  const std::string keys = "geometry.window_x_min_m, geometry.window_x_max_m";
+  // Magnet material where toner can go: the field there is the one inside a magnet, and a toner
+  // cannot be there. Sampled along every block edge every 1 um (a part of a block above the
+  // surface has edge points above it: straight up from any such point one meets the boundary).
+  const double cx = r.roller_centre.x;
+  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+  for (const auto& poly : f.material()) {
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+      const Vec2 a = poly[i], b = poly[(i + 1) % poly.size()];
+      const int n = std::max(1, static_cast<int>(std::ceil(norm(b - a) / 1e-6)));
+      for (int k = 0; k <= n; ++k) {
+        const Vec2 p = a + (static_cast<double>(k) / n) * (b - a);
+        if (std::fabs(p.x - cx) >= r.roller_radius || p.y <= r.y_low(p.x)) continue;
+        if (p.x >= cx) hi = std::min(hi, p.x);
+        else lo = std::max(lo, p.x);
+      }
+    }
+  }
+  if (r.x_min <= lo || r.x_max >= hi)
+    throw_input(field_name, keys, window,
+                fmt::format("the magnet's material reaches above the imaging-roller surface less the pit depth ({:.3g} um) "
+                            "at x {} mm, where toner can go: the field is not valid there (docs/magnetic.md, \"Field tables\")",
+                            1e6 * r.pit_depth, r.x_max >= hi ? fmt::format(">= {:.4g}", 1e3 * hi) : fmt::format("<= {:.4g}", 1e3 * lo)),
+                fmt::format("a window inside the valid region x in ({:.4g}, {:.4g}) mm", 1e3 * lo, 1e3 * hi));
+  // A map must cover everything a toner centre can reach: the window from the roller surface
+  // less the pits up to the drum.
+  if (const auto* m = dynamic_cast<const io::FieldMap*>(&f)) {
+    double ylo = std::numeric_limits<double>::infinity(), yhi = -ylo;
+    const int n = 200;
+    for (int k = 0; k <= n; ++k) {
+      const double x = r.x_min + (r.x_max - r.x_min) * k / n;
+      ylo = std::min(ylo, r.y_low(x));
+      yhi = std::max(yhi, r.y_high(x));
+    }
+    if (m->x_min() > r.x_min || m->x_max() < r.x_max || m->y_min() > ylo || m->y_max() < yhi)
+      throw_input(field_name, "magnet.map_file",
+                  fmt::format("x [{:.4g}, {:.4g}] mm, y [{:.4g}, {:.4g}] um", 1e3 * m->x_min(), 1e3 * m->x_max(), 1e6 * m->y_min(), 1e6 * m->y_max()),
+                  fmt::format("the map does not cover where toner can go (window {} from {}, y from the roller surface less the pits to the drum)", window, keys),
+                  fmt::format("a map covering x [{:.4g}, {:.4g}] mm, y [{:.4g}, {:.4g}] um", 1e3 * r.x_min, 1e3 * r.x_max, 1e6 * ylo, 1e6 * yhi));
   }
 }
 

@@ -38,6 +38,10 @@ struct MagnetConfig {
 // square tiles (h = 20 um, bicubic Hermite as io::FieldMap): about 3x cheaper per particle,
 // force error < 1e-4 relative (docs/performance.md). A tile's content depends only on its
 // position, never on when it was built, so results stay deterministic and resume-exact.
+// A cell whose interpolation stencil (the cell and two nodes beyond it on each side) touches a
+// magnet face, where the field jumps, is never interpolated: it is evaluated exactly
+// (docs/magnetic.md, "Field tables"). Where toner may go at all is checked at setup
+// (check_field_region).
 // Optionally the dipole-dipole force between the induced moments within a cut-off, with the
 // moments induced by the magnet's field only (§4.5); it is re-evaluated every
 // `dipole_interval` steps and held in between (multiple time stepping; docs/magnetic.md),
@@ -54,21 +58,32 @@ class MagnetForce final : public engine::BodyForce {
   // Induced moments of the last field evaluation, per body [A m^2].
   const std::vector<Vec2>& moments() const { return moment_; }
   const dipole::PairSum& dipole_pairs() const { return pairs_; }
+  // The field sample the force uses at p (from the table where it applies, built on demand;
+  // not thread-safe): for tests and benchmarks that check the table against the source.
+  magnet::Sample field_sample(Vec2 p) { return field_at(p); }
   void save(std::ostream& o) const override;
   void load(std::istream& in) override;
 
  private:
   void dipole_pass(const BodyStore& b, bool same_set);
   void field_pass(const BodyStore& b);
+  // One tile of the table: an interpolant over its cells, or nothing (evaluate the source: a
+  // node on a magnet corner), and the cells whose stencil touches a magnet face.
+  struct Tile {
+    std::shared_ptr<const magnet::MagnetField> map;  // null: exact everywhere in the tile
+    double x0 = 0.0, y0 = 0.0;                      // lower-left corner of the tile's first cell [m]
+    std::vector<unsigned char> exact_cell;          // kTileCells^2, row-major in y; empty if none
+  };
   magnet::Sample field_at(Vec2 p);
-  const magnet::MagnetField* tile_for(Vec2 p);  // builds the tile if needed; null = use field_
+  const Tile* tile_for(Vec2 p);  // builds the tile if needed; null = outside the table: use field_
+  magnet::Sample sample(const Tile* t, Vec2 p) const;
   std::shared_ptr<const magnet::MagnetField> field_;
   // Tabulated field: tiles_[ty * kTilesX + tx] covers [x_lo + tx T, x_lo + (tx+1) T) x (same in y).
   static constexpr double kTileH = 20e-6;  // node spacing [m]
   static constexpr int kTileCells = 20;    // cells per tile side (T = 400 um)
   static constexpr int kTilesX = 64, kTilesY = 32;
   bool tabulate_ = false;
-  std::vector<std::shared_ptr<const magnet::MagnetField>> tiles_;  // a tile, or field_ itself
+  std::vector<std::unique_ptr<Tile>> tiles_;
   MagnetConfig cfg_;
   std::vector<Vec2> moment_;
   std::vector<double> dfx_, dfy_;
@@ -134,5 +149,19 @@ class ElectricForce final : public engine::BodyForce {
 
 // The field a MagnetConfig names (throws InputError for an unreadable map).
 std::shared_ptr<const magnet::MagnetField> make_magnet_field(const MagnetConfig& c);
+
+// The part of the process plane a toner centre can reach: x in [x_min, x_max], y from the
+// imaging-roller surface less the pit depth up to the drum surface (both circles).
+struct ReachableRegion {
+  double x_min = 0.0, x_max = 0.0;       // [m] the window
+  Vec2 roller_centre{}, drum_centre{};   // [m]
+  double roller_radius = 0.0, drum_radius = 0.0, pit_depth = 0.0;  // [m]
+  double y_low(double x) const;   // lowest reachable y at x (roller surface - pit depth)
+  double y_high(double x) const;  // the drum surface at x
+};
+// Refuses (InputError naming the window keys and the region where the field is valid) a field
+// that is not valid where toner can go: magnet material reaching into the region (the field a
+// toner feels is never the one inside a magnet), or a field map that does not cover it.
+void check_field_region(const magnet::MagnetField& f, const ReachableRegion& r, const std::string& field_name);
 
 }  // namespace nipdem::experiments

@@ -1,5 +1,6 @@
 #include "nipdem/models/magnet_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -115,6 +116,43 @@ Sample BlockAssembly::at(Vec2 p) const {
   return s;
 }
 
+namespace {
+// Does the segment a-b meet the closed box [lo, hi]? (Liang-Barsky clipping.)
+bool segment_meets_box(Vec2 a, Vec2 b, Vec2 lo, Vec2 hi) {
+  double t0 = 0.0, t1 = 1.0;
+  const double d[2] = {b.x - a.x, b.y - a.y}, p0[2] = {a.x, a.y}, l[2] = {lo.x, lo.y}, h[2] = {hi.x, hi.y};
+  for (int k = 0; k < 2; ++k) {
+    if (d[k] == 0.0) {
+      if (p0[k] < l[k] || p0[k] > h[k]) return false;
+      continue;
+    }
+    double ta = (l[k] - p0[k]) / d[k], tb = (h[k] - p0[k]) / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+}  // namespace
+
+// Inside a uniformly magnetised block and outside all blocks the field is analytic; it jumps only
+// across the edges (the current sheets), so a box no edge touches holds a smooth field.
+bool BlockAssembly::smooth_in(Vec2 lo, Vec2 hi) const {
+  for (const auto& b : blocks_) {
+    const auto& v = b.vertices_m;
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (segment_meets_box(v[i], v[(i + 1) % v.size()], lo, hi)) return false;
+  }
+  return true;
+}
+
+std::vector<std::vector<Vec2>> BlockAssembly::material() const {
+  std::vector<std::vector<Vec2>> m;
+  for (const auto& b : blocks_) m.push_back(b.vertices_m);
+  return m;
+}
+
 std::string BlockAssembly::describe() const {
   return fmt::format("{} ({} blocks, analytic 2D prism field)", name_, blocks_.size());
 }
@@ -208,5 +246,24 @@ Sample PlacedField::at(Vec2 p) const {
 }
 
 std::string PlacedField::describe() const { return inner_->describe() + " (placed)"; }
+
+bool PlacedField::smooth_in(Vec2 lo, Vec2 hi) const {
+  // bounding box of the engine-frame box in the inner frame (conservative for a rotation)
+  Vec2 a{1e300, 1e300}, b{-1e300, -1e300};
+  for (Vec2 c : {lo, hi, Vec2{lo.x, hi.y}, Vec2{hi.x, lo.y}}) {
+    const Vec2 d = c - origin_;
+    const Vec2 l{c_ * d.x + s_ * d.y, -s_ * d.x + c_ * d.y};
+    a = {std::min(a.x, l.x), std::min(a.y, l.y)};
+    b = {std::max(b.x, l.x), std::max(b.y, l.y)};
+  }
+  return inner_->smooth_in(a, b);
+}
+
+std::vector<std::vector<Vec2>> PlacedField::material() const {
+  auto m = inner_->material();
+  for (auto& poly : m)
+    for (auto& v : poly) v = origin_ + Vec2{c_ * v.x - s_ * v.y, s_ * v.x + c_ * v.y};
+  return m;
+}
 
 }  // namespace nipdem::magnet

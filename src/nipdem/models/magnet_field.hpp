@@ -39,6 +39,12 @@ class MagnetField {
   virtual Sample at(Vec2 p) const = 0;
   // One line saying what the source is (for output headers and logs).
   virtual std::string describe() const = 0;
+  // False if the field may be discontinuous (a magnet face: tangential B jumps by mu0 M) inside
+  // the closed box [lo, hi]; an interpolating table must not span such a box.
+  virtual bool smooth_in(Vec2 /*lo*/, Vec2 /*hi*/) const { return true; }
+  // Cross-sections of the magnet material (polygons, [m]), where the field is not a field a toner
+  // can feel: empty if the source does not know its material (a field map).
+  virtual std::vector<std::vector<Vec2>> material() const { return {}; }
 };
 
 // Force on a point dipole m [A m^2] in the field sample: F = (m . grad) B [N] (eq. 2.4.28/2.4.34).
@@ -77,6 +83,8 @@ class BlockAssembly final : public MagnetField {
   explicit BlockAssembly(std::vector<MagnetBlock> blocks, std::string name = "block assembly");
   Sample at(Vec2 p) const override;
   std::string describe() const override;
+  bool smooth_in(Vec2 lo, Vec2 hi) const override;  // no block edge touches the box
+  std::vector<std::vector<Vec2>> material() const override;
   const std::vector<MagnetBlock>& blocks() const { return blocks_; }
 
  private:
@@ -131,6 +139,8 @@ class PlacedField final : public MagnetField {
   PlacedField(std::shared_ptr<const MagnetField> inner, Vec2 origin_m, double angle_rad);
   Sample at(Vec2 p) const override;
   std::string describe() const override;
+  bool smooth_in(Vec2 lo, Vec2 hi) const override;  // asks the inner source for the box's bounding box
+  std::vector<std::vector<Vec2>> material() const override;
 
  private:
   std::shared_ptr<const MagnetField> inner_;
