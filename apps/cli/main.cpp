@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
 #include "nipdem/version.hpp"
 #include "registry.hpp"
 
@@ -27,6 +28,18 @@ void print_json(const std::string& json) {
   std::fwrite(json.data(), 1, json.size(), stdout);
   std::fputc('\n', stdout);
   std::fflush(stdout);
+}
+
+void finish_report(const nlohmann::json& j, const std::filesystem::path& out, const std::string& name, bool json,
+                   const std::string& summary) {
+  std::filesystem::create_directories(out);
+  io::write_file_atomic(out / (name + ".json"), j.dump(2));
+  if (json) {
+    print_json(j.dump());
+  } else {
+    std::fputs(summary.c_str(), stdout);
+    std::fprintf(stderr, "%s: results in %s\n", name.c_str(), out.string().c_str());
+  }
 }
 
 }  // namespace nipdem::cli
