@@ -51,7 +51,7 @@ TEST(CalibrationRecord, BadInputNamesFileLineAndColumn) {
     EXPECT_NE(e.find("rec.csv"), std::string::npos) << e;
     EXPECT_NE(e.find(c.needle), std::string::npos) << e;
   }
-  EXPECT_NE(error_of("x_m,force_N\n0,1\n1,-2\n").find("(0, inf]"), std::string::npos);  // names the allowed range
+  EXPECT_NE(error_of("x_m,force_N\n0,1\n1,-2\n").find("(0, inf)"), std::string::npos);  // names the allowed range
 }
 
 TEST(CalibrationRecord, FormatRoundTrips) {

@@ -12,9 +12,9 @@ std::string Record::where(std::size_t i) const { return fmt::format("{}:{}", sou
 
 namespace {
 std::string range_text(const ColumnSpec& s) {
-  const std::string lo = s.lo <= -1e300 ? "-inf" : fmt::format("{:g}", s.lo);
-  const std::string hi = s.hi >= 1e300 ? "inf" : fmt::format("{:g}", s.hi);
-  return fmt::format("{}{}, {}]", s.lo_open ? "(" : "[", lo, hi);
+  const std::string lo = s.lo <= -1e300 ? "(-inf" : fmt::format("{}{:g}", s.lo_open ? "(" : "[", s.lo);
+  const std::string hi = s.hi >= 1e300 ? "inf)" : fmt::format("{:g}]", s.hi);
+  return lo + ", " + hi;
 }
 }  // namespace
 
