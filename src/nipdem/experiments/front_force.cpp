@@ -107,9 +107,10 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
   const int nx = static_cast<int>(std::floor((f.x_max_m - f.x_min_m) / f.dx_m + 1e-9)) + 1;
   std::vector<std::vector<double>> rows;
   io::PlotSpec pe, pp;
-  pe.title = fmt::format("Net y-force on a front particle, {} (R = d95/2 = {:.2g} µm, {:g} V, w_h = {:g} µm): exact",
-                         e.config.empty() ? e.preset : e.config, 1e6 * m.radius_m, m.voltage_V, 1e6 * f.gap_m);
-  pp.title = fmt::format("Same with eq. 2.5.31 as printed (2x the physical electric force)");
+  const std::string name = e.config.empty() ? e.preset : std::filesystem::path(e.config).stem().string();
+  const std::string setting = fmt::format("{}, R = {:.3g} µm, {:g} V, w_h = {:g} µm", name, 1e6 * m.radius_m, m.voltage_V, 1e6 * f.gap_m);
+  pe.title = "Net y-force, front particle: " + setting;
+  pp.title = "Same, eq. 2.5.31 as printed: " + setting;
   for (auto* p : {&pe, &pp}) {
     p->x_label = "x [µm] (magnet edge at 0, supply roller at +x)";
     p->y_label = "net y-force [nN] (+: to the DI-drum, -: to the roller)";
@@ -187,6 +188,52 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
   pc.y_min = 0.0;
   io::write_plot_png(out / "front_force_crossing.png", pc);
 
+  // Map over (x, l) on a finer l grid reaching past the largest crossing, with the crossings on top.
+  double l_top = *std::max_element(f.l_m.begin(), f.l_m.end());
+  for (const auto& c : crow)
+    for (int k : {1, 2})
+      if (std::isfinite(c[k])) l_top = std::max(l_top, 1.15 * c[k]);
+  const int nl = 80;
+  io::Heatmap hm;
+  hm.z_label = "net y-force [nN] (+: to the drum)";
+  double mag_max = 0;  // largest magnet pull on the map [N]
+  std::vector<std::vector<double>> mrow;
+  for (int i = 0; i < nx; ++i) hm.x.push_back(1e6 * (f.x_min_m + i * f.dx_m));
+  for (int j = 0; j < nl; ++j) {
+    const double l = 0.5e-6 + (l_top - 0.5e-6) * j / (nl - 1);
+    hm.y.push_back(1e6 * l);
+    for (int i = 0; i < nx; ++i) {
+      const FrontForcePoint p = m.at(f.x_min_m + i * f.dx_m, l);
+      hm.z.push_back(1e9 * p.net_exact_N());
+      mag_max = std::max(mag_max, std::fabs(p.magnetic_N));
+      mrow.push_back({p.x_m, p.l_m, p.net_exact_N(), p.net_printed_N()});
+    }
+  }
+  io::write_csv(out / "front_force_map.csv", {"x_m", "l_m", "net_exact_y_N", "net_printed_y_N"}, mrow);
+  // Colour scale: blue down to the most negative net force, red up to 3x its size, so the sign
+  // change is visible; the strong electric force close to the drum takes the end colour (its
+  // values are in the CSV).
+  double z_neg = 0;
+  for (double z : hm.z) z_neg = std::min(z_neg, z);
+  if (z_neg == 0) z_neg = -1e9 * mag_max;
+  hm.z_min = z_neg;
+  hm.z_max = -3 * z_neg;
+  io::PlotSpec pm;
+  pm.title = "Net y-force map (exact electric force): " + setting;
+  pm.x_label = pe.x_label;
+  pm.y_label = "distance from the DI-drum l [µm]";
+  pm.heatmap = hm;
+  io::Series ke = ce, kp = cp, kd = sd;
+  kd.color = std::array<double, 3>{0.17, 0.63, 0.17};
+  ke.label = "net force = 0 (exact)";
+  ke.color = std::array<double, 3>{0, 0, 0};
+  kp.label = "net force = 0 (as printed)";
+  kp.color = std::array<double, 3>{0.2, 0.2, 0.2};
+  pm.series = {ke, kp, kd};
+  pm.y_min = 0.0;
+  pm.y_max = 1e6 * l_top;
+  io::write_plot_png(out / "front_force_map.png", pm);
+
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   auto opt_num = [](bool open, double v) { return open ? nlohmann::json(nullptr) : nlohmann::json(v); };
   return {{"experiment", "front-force"},
@@ -211,6 +258,8 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
           {"rows", per_l},
           {"csv", (out / "front_force.csv").string()},
           {"crossing_csv", (out / "front_force_crossing.csv").string()},
+          {"map_csv", (out / "front_force_map.csv").string()},
+          {"plot_map", (out / "front_force_map.png").string()},
           {"plot", (out / "front_force.png").string()},
           {"plot_printed", (out / "front_force_printed.png").string()},
           {"plot_crossing", (out / "front_force_crossing.png").string()},

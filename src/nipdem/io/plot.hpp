@@ -39,9 +39,10 @@ struct Series {
 // A colour map drawn under the series (linear axes only): z[j * nx + i] is the value of the cell
 // centred at (x[i], y[j]); x and y strictly increasing, at least 2 each; cell edges lie halfway
 // between centres. NaN cells stay blank. Colours are diverging (blue < 0 < red, white at 0), made
-// for signed data such as a net force; the limits default to +-max|z| and values beyond given
-// limits take the end colours (the colour bar says so with its end labels "<=" / ">="). A colour
-// bar labelled `z_label` (with unit) is drawn right of the plot.
+// for signed data such as a net force; the limits default to +-max|z|, each side of zero is scaled
+// to its own limit, and values beyond given limits take the end colours (display only; a tick at
+// a limit is labelled "<=" / ">="). A colour bar labelled `z_label` (with unit) is drawn right of
+// the plot.
 struct Heatmap {
   std::vector<double> x, y, z;
   std::string z_label;
