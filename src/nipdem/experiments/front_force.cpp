@@ -105,6 +105,8 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
   const std::filesystem::path& out = e.out;
   std::filesystem::create_directories(out);
   const int nx = static_cast<int>(std::floor((f.x_max_m - f.x_min_m) / f.dx_m + 1e-9)) + 1;
+  // Front region membership of a grid x (a tolerance of dx/1000 absorbs the grid's round-off).
+  auto in_front = [&](double x) { return x >= f.front_x_min_m - 1e-3 * f.dx_m && x <= f.front_x_max_m + 1e-3 * f.dx_m; };
   std::vector<std::vector<double>> rows;
   io::PlotSpec pe, pp;
   const std::string name = e.config.empty() ? e.preset : std::filesystem::path(e.config).stem().string();
@@ -134,7 +136,7 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
       sp.y.push_back(1e9 * p.net_printed_N());
       fe_min = std::min(fe_min, p.net_exact_N());
       fe_max = std::max(fe_max, p.net_exact_N());
-      if (x >= f.front_x_min_m && x <= f.front_x_max_m) {
+      if (in_front(x)) {
         ++n_front;
         if (p.net_exact_N() > 0) ++to_drum_front;
       }
@@ -173,7 +175,7 @@ nlohmann::json front_force(const ExperimentOptions& e, const FrontForceOptions& 
     ce.y.push_back(1e6 * le);
     cp.x.push_back(1e6 * x);
     cp.y.push_back(1e6 * lp);
-    if (x < f.front_x_min_m || x > f.front_x_max_m) continue;
+    if (!in_front(x)) continue;
     if (std::isnan(le)) open_e = true; else if (le > lmax_e) { lmax_e = le; x_at_e = x; }
     if (std::isnan(lp)) open_p = true; else if (lp > lmax_p) { lmax_p = lp; x_at_p = x; }
   }
