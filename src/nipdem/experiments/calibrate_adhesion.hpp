@@ -9,7 +9,7 @@
 //    weights sqrt(max(p(1-p), 1/N0)/N0), p the measured fraction, N0 the particles counted before
 //    spinning. The fractions are nested (the same particles are counted again after every run),
 //    so their errors are correlated and the least-squares covariance under-states the
-//    uncertainty (by ~2x in tests). Standard errors therefore come from a parametric bootstrap
+//    uncertainty (by ~3x in tests). Standard errors therefore come from a parametric bootstrap
 //    with a fixed seed: `bootstrap` records of N0 particles drawn from the fitted distribution
 //    through the same forward model, each refitted; se = sd of the refitted parameters.
 //  - AFM pull-off forces (fig. 4.16): one force per row. Maximum likelihood: mu = mean ln F,
