@@ -3,9 +3,7 @@
 // See src/nipdem/experiments/front_force.hpp.
 #include <fmt/format.h>
 #include <memory>
-#include <sstream>
 
-#include "nipdem/core/error.hpp"
 #include "nipdem/experiments/front_force.hpp"
 #include "registry.hpp"
 
@@ -17,22 +15,6 @@ struct Opts {
   std::string l_list, out;
   bool json = false;
 };
-
-std::vector<double> parse_l(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t pos = 0;
-      v.push_back(std::stod(item, &pos));
-      if (pos != item.size()) throw std::invalid_argument("trailing");
-    } catch (const std::exception&) {
-      nipdem::throw_input("experiment front-force", "--l", "\"" + text + "\"", "expected a comma-separated list of distances in m");
-    }
-  }
-  return v;
-}
 
 nipdem::cli::Register reg([](CLI::App& app) {
   auto* g = nipdem::cli::group(app, "experiment", "Experiments of thesis chapters 4-5 (ensembles on threads or MPI)");
@@ -52,7 +34,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--out", c->out, "output folder (default runs/front_force)");
   sub->add_flag("--json", c->json, "print one JSON object on stdout");
   sub->callback([c] {
-    if (!c->l_list.empty()) c->f.l_m = parse_l(c->l_list);
+    if (!c->l_list.empty()) c->f.l_m = nipdem::cli::parse_number_list(c->l_list, "experiment front-force", "--l");
     c->e.out = c->out.empty() ? "runs/front_force" : c->out;
     const auto j = nipdem::experiments::front_force(c->e, c->f);
     auto um = [&](const char* k) { return j[k].is_null() ? std::string("none (net force to the drum at 100 um)") : fmt::format("{:.3g} um", 1e6 * j[k].get<double>()); };

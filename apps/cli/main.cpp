@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <sstream>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/atomic_file.hpp"
@@ -28,6 +29,23 @@ void print_json(const std::string& json) {
   std::fwrite(json.data(), 1, json.size(), stdout);
   std::fputc('\n', stdout);
   std::fflush(stdout);
+}
+
+std::vector<double> parse_number_list(const std::string& text, const std::string& where, const std::string& key) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t pos = 0;
+      v.push_back(std::stod(item, &pos));
+      if (pos != item.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw_input(where, key, "\"" + text + "\"", "expected a comma-separated list of numbers");
+    }
+  }
+  if (v.empty()) throw_input(where, key, "\"" + text + "\"", "empty list");
+  return v;
 }
 
 void finish_report(const nlohmann::json& j, const std::filesystem::path& out, const std::string& name, bool json,

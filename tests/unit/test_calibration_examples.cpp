@@ -43,37 +43,36 @@ void check_or_write(const std::string& name, const Record& r, const std::string&
 }
 }  // namespace
 
+namespace {
+// One friction example: made, checked against the shipped file, and calibrated back.
+void friction_example(const std::string& name, const FrictionSynth& s, const FrictionOptions& o, std::uint64_t seed,
+                      const std::string& recipe) {
+  check_or_write(name, synthetic_friction_record(s, o, seed), recipe, read_friction_record);
+  const FrictionResult f = calibrate_friction(read_friction_record(kDir / name), o);
+  EXPECT_NEAR(f.mu_s, s.mu_s, 3 * f.mu_s_std) << name;  // 3 standard errors
+  EXPECT_NEAR(f.mu_d, s.mu_d, 3 * f.mu_d_std) << name;
+}
+}  // namespace
+
 TEST(CalibrationExamples, FrictionPlateAndCapstan) {
   FrictionSynth s;  // toner-toner, §4.3.1: mu_s 0.47, mu_d 0.19
   s.x_end_m = 40e-3;
   s.dx_m = 50e-6;
-  FrictionOptions plate;  // 26 g sample + 211 g weight
-  const Record a = synthetic_friction_record(s, plate, 1);
-  check_or_write("friction_plate.csv", a,
-                 "Plate-pull record (fig. 4.7): mu_s = 0.47, mu_d = 0.19, sample 0.026 kg, weight 0.211 kg, g = 9.81,\n"
-                 "stick-slip up to 5 mm, sticks of 0.8 mm, noise 0.005 N, seed 1.\n"
-                 "Run: nipdem calibrate friction --data examples/calibration/friction_plate.csv --setup plate",
-                 read_friction_record);
-  const FrictionResult fa = calibrate_friction(read_friction_record(kDir / "friction_plate.csv"), plate);
-  EXPECT_NEAR(fa.mu_s, 0.47, 3 * fa.mu_s_std);  // 3 standard errors
-  EXPECT_NEAR(fa.mu_d, 0.19, 3 * fa.mu_d_std);
-
+  friction_example("friction_plate.csv", s, FrictionOptions{}, 1,  // 26 g sample + 211 g weight
+                   "Plate-pull record (fig. 4.7): mu_s = 0.47, mu_d = 0.19, sample 0.026 kg, weight 0.211 kg, g = 9.81,\n"
+                   "stick-slip up to 5 mm, sticks of 0.8 mm, noise 0.005 N, seed 1.\n"
+                   "Run: nipdem calibrate friction --data examples/calibration/friction_plate.csv --setup plate");
   FrictionSynth d = s;  // toner-DI drum, §4.3.1: mu_s 0.53, mu_d 0.34
   d.mu_s = 0.53;
   d.mu_d = 0.34;
   FrictionOptions cap;
   cap.setup = FrictionSetup::capstan;
   cap.weight_mass_kg = 0.1;
-  const Record b = synthetic_friction_record(d, cap, 2);
-  check_or_write("friction_capstan.csv", b,
-                 "Capstan record (fig. 4.10, eq. 4.3.3, wrap pi/2): mu_s = 0.53, mu_d = 0.34, hanging weight 0.1 kg,\n"
-                 "g = 9.81, stick-slip up to 5 mm, noise 0.005 N, seed 2.\n"
-                 "Run: nipdem calibrate friction --data examples/calibration/friction_capstan.csv --setup capstan "
-                 "--weight-mass-kg 0.1",
-                 read_friction_record);
-  const FrictionResult fb = calibrate_friction(read_friction_record(kDir / "friction_capstan.csv"), cap);
-  EXPECT_NEAR(fb.mu_s, 0.53, 3 * fb.mu_s_std);  // 3 standard errors
-  EXPECT_NEAR(fb.mu_d, 0.34, 3 * fb.mu_d_std);
+  friction_example("friction_capstan.csv", d, cap, 2,
+                   "Capstan record (fig. 4.10, eq. 4.3.3, wrap pi/2): mu_s = 0.53, mu_d = 0.34, hanging weight 0.1 kg,\n"
+                   "g = 9.81, stick-slip up to 5 mm, noise 0.005 N, seed 2.\n"
+                   "Run: nipdem calibrate friction --data examples/calibration/friction_capstan.csv --setup capstan "
+                   "--weight-mass-kg 0.1");
 }
 
 TEST(CalibrationExamples, AdhesionCentrifugalAndAfm) {
