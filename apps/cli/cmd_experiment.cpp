@@ -22,20 +22,7 @@ struct Common {
 };
 
 std::vector<double> parse_list(const std::string& text, const std::string& key) {
-  std::vector<double> v;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t pos = 0;
-      v.push_back(std::stod(item, &pos));
-      if (pos != item.size()) throw std::invalid_argument("trailing");
-    } catch (const std::exception&) {
-      nipdem::throw_input("experiment", key, "\"" + text + "\"", "expected a comma-separated list of numbers");
-    }
-  }
-  if (v.empty()) nipdem::throw_input("experiment", key, "\"" + text + "\"", "empty list");
-  return v;
+  return nipdem::cli::parse_number_list(text, "experiment", key);
 }
 
 void add_common(CLI::App* sub, const std::shared_ptr<Common>& c, const std::string& name, bool mpi = true) {

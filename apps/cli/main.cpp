@@ -2,8 +2,10 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <sstream>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
 #include "nipdem/version.hpp"
 #include "registry.hpp"
 
@@ -27,6 +29,35 @@ void print_json(const std::string& json) {
   std::fwrite(json.data(), 1, json.size(), stdout);
   std::fputc('\n', stdout);
   std::fflush(stdout);
+}
+
+std::vector<double> parse_number_list(const std::string& text, const std::string& where, const std::string& key) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t pos = 0;
+      v.push_back(std::stod(item, &pos));
+      if (pos != item.size()) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw_input(where, key, "\"" + text + "\"", "expected a comma-separated list of numbers");
+    }
+  }
+  if (v.empty()) throw_input(where, key, "\"" + text + "\"", "empty list");
+  return v;
+}
+
+void finish_report(const nlohmann::json& j, const std::filesystem::path& out, const std::string& name, bool json,
+                   const std::string& summary) {
+  std::filesystem::create_directories(out);
+  io::write_file_atomic(out / (name + ".json"), j.dump(2));
+  if (json) {
+    print_json(j.dump());
+  } else {
+    std::fputs(summary.c_str(), stdout);
+    std::fprintf(stderr, "%s: results in %s\n", name.c_str(), out.string().c_str());
+  }
 }
 
 }  // namespace nipdem::cli

@@ -10,6 +10,8 @@
 // Callbacks report bad input by throwing nipdem::InputError (exit 2); anything else exits 1.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <functional>
 #include <string>
 #include <vector>
@@ -29,5 +31,13 @@ CLI::App* group(CLI::App& app, const std::string& name, const std::string& descr
 
 // Prints one JSON document (already serialised) on stdout followed by a newline.
 void print_json(const std::string& json);
+
+// Parses "a,b,c" into numbers; a bad item or an empty list is an InputError naming `where` and `key`.
+std::vector<double> parse_number_list(const std::string& text, const std::string& where, const std::string& key);
+
+// Writes `j` to OUT/NAME.json; prints it on stdout with --json, otherwise prints `summary` on
+// stdout and names the folder on stderr (the calibrations and front-force).
+void finish_report(const nlohmann::json& j, const std::filesystem::path& out, const std::string& name, bool json,
+                   const std::string& summary);
 
 }  // namespace nipdem::cli

@@ -10,24 +10,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../cli_run.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
-struct Res { int status; std::string out, err; };
-Res cli(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / ("nipdem_exp_err_" + std::to_string(::getpid()));
-  FILE* p = popen((std::string(NIPDEM_CLI_PATH) + " " + args + " 2>" + err.string()).c_str(), "r");
-  Res r{};
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-  const int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  r.err = nipdem::io::read_file(err);
-  fs::remove(err);
-  return r;
-}
+using Res = nipdem::test::CliResult;
+Res cli(const std::string& args) { return nipdem::test::run_cli(args, "exp"); }
 }  // namespace
 
 TEST(ExperimentCli, BadSweepSpecificationsExitTwo) {

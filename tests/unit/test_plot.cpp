@@ -171,6 +171,37 @@ TEST(AnalysisPlot, CoverageCurveWithFitExample) {
   fs::remove_all(dir);
 }
 
+TEST(AnalysisPlot, HeatmapColoursBySignUnderTheSeries) {
+  const fs::path d = fresh_dir("heat");
+  io::PlotSpec p;
+  io::Heatmap h;
+  h.x = {0, 1, 2, 3};
+  h.y = {0, 1};
+  h.z = {-2, -2, 2, 2, -2, -2, 2, 2};  // left half negative, right half positive
+  h.z_label = "F [nN]";
+  p.heatmap = h;
+  io::write_plot_png(d / "h.png", p);
+  const auto blue = io::diverging_colour(-1.0), red = io::diverging_colour(1.0);
+  const int nb = count_colour(d / "h.png", blue[0], blue[1], blue[2]);
+  const int nr = count_colour(d / "h.png", red[0], red[1], red[2]);
+  EXPECT_GT(nb, 20000);  // each half of the ~700 x 450 px area, less the grid lines
+  EXPECT_GT(nr, 20000);
+  EXPECT_NEAR(static_cast<double>(nb) / nr, 1.0, 0.1);  // equal halves (the colour bar adds a little of each)
+  const auto w = io::diverging_colour(0.0);
+  EXPECT_DOUBLE_EQ(w[0] + w[1] + w[2], 3.0);  // white at zero
+  EXPECT_EQ(io::diverging_colour(5.0), red);      // display saturation beyond the limits
+  // Bad heat maps are input errors naming the problem.
+  p.heatmap->z.pop_back();
+  EXPECT_THROW(io::write_plot_png(d / "bad.png", p), InputError);
+  p.heatmap = h;
+  p.heatmap->y = {1, 0};
+  EXPECT_THROW(io::write_plot_png(d / "bad.png", p), InputError);
+  p.heatmap = h;
+  p.log_x = true;
+  EXPECT_THROW(io::write_plot_png(d / "bad.png", p), InputError);
+  fs::remove_all(d);
+}
+
 TEST(AnalysisPlot, BadDataIsAnInputError) {
   const fs::path dir = fresh_dir("bad");
   io::PlotSpec p;

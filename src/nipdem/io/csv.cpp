@@ -127,6 +127,7 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
         t.columns.emplace_back(cells[j]);
       }
       have_header = true;
+      t.header_line = line_no;
     } else {
       if (cells.size() != t.columns.size())
         throw InputError(input_message(where, "", "",
@@ -146,6 +147,7 @@ CsvTable parse_csv(std::string_view text, const std::string& source) {
         row[j] = v;
       }
       t.rows.push_back(std::move(row));
+      t.lines.push_back(line_no);
     }
     if (nl == text.size()) break;
   }

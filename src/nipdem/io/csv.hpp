@@ -19,6 +19,8 @@ struct CsvTable {
   std::string source;                      // file name (or label) used in messages
   std::vector<std::string> columns;        // header names
   std::vector<std::vector<double>> rows;   // rows[i].size() == columns.size()
+  std::vector<std::size_t> lines;          // lines[i]: 1-based file line of rows[i] (filled by parse_csv)
+  std::size_t header_line = 0;             // 1-based file line of the header (parse_csv)
 
   // Index of column `name`; throws InputError naming the source and the available columns.
   std::size_t column_index(const std::string& name) const;

@@ -93,6 +93,14 @@ void show_text_at(cairo_t* cr, const std::string& s, double x, double y, double 
 
 }  // namespace
 
+std::array<double, 3> diverging_colour(double t) {
+  t = std::clamp(t, -1.0, 1.0);  // display only: the data are never changed
+  const std::array<double, 3> neg{0.13, 0.40, 0.67}, pos{0.70, 0.09, 0.17};
+  const auto& end = t < 0 ? neg : pos;
+  const double a = std::fabs(t);
+  return {1 + a * (end[0] - 1), 1 + a * (end[1] - 1), 1 + a * (end[2] - 1)};
+}
+
 std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return {lo};
   target = std::max(target, 2);
@@ -182,7 +190,7 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
   if (spec.width < 100 || spec.height < 100 || spec.width > 10000 || spec.height > 10000)
     throw_input(where, "size", fmt::format("{}x{}", spec.width, spec.height), "image size out of range",
                 "100..10000 px each");
-  if (spec.series.empty()) throw_input(where, "series", "none", "nothing to plot");
+  if (spec.series.empty() && !spec.heatmap) throw_input(where, "series", "none", "nothing to plot");
 
   // Validate data and find the ranges.
   double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo, ylo = xlo, yhi = -xlo;
@@ -207,6 +215,42 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
         extend(y + e, ylo, yhi);
       }
     }
+  }
+  // Heat map: validate, extend the ranges to the cell edges, find the colour limits.
+  double zlo = 0, zhi = 0;
+  std::vector<double> hx_edges, hy_edges;
+  if (spec.heatmap) {
+    const Heatmap& hm = *spec.heatmap;
+    if (spec.log_x || spec.log_y) throw_input(where, "heatmap", "", "a heat map needs linear axes");
+    if (hm.x.size() < 2 || hm.y.size() < 2)
+      throw_input(where, "heatmap", fmt::format("{} x {} cells", hm.x.size(), hm.y.size()), "too few cells", ">= 2 x 2");
+    if (hm.z.size() != hm.x.size() * hm.y.size())
+      throw_input(where, "heatmap", fmt::format("{} values", hm.z.size()), "z size differs from nx * ny",
+                  fmt::format("{}", hm.x.size() * hm.y.size()));
+    auto edges = [&](const std::vector<double>& c, const char* name) {
+      std::vector<double> e(c.size() + 1);
+      for (std::size_t i = 0; i < c.size(); ++i)
+        if (!std::isfinite(c[i]) || (i > 0 && !(c[i] > c[i - 1])))
+          throw_input(where, std::string("heatmap ") + name, fmt::format("{:g}", c[i]), "not finite and strictly increasing");
+      for (std::size_t i = 1; i < c.size(); ++i) e[i] = 0.5 * (c[i - 1] + c[i]);
+      e[0] = c[0] - (e[1] - c[0]);
+      e[c.size()] = c.back() + (c.back() - e[c.size() - 1]);
+      return e;
+    };
+    hx_edges = edges(hm.x, "x");
+    hy_edges = edges(hm.y, "y");
+    extend(hx_edges.front(), xlo, xhi);
+    extend(hx_edges.back(), xlo, xhi);
+    extend(hy_edges.front(), ylo, yhi);
+    extend(hy_edges.back(), ylo, yhi);
+    double amax = 0;
+    for (double z : hm.z)
+      if (std::isfinite(z)) amax = std::max(amax, std::fabs(z));
+    zlo = hm.z_min.value_or(-amax);
+    zhi = hm.z_max.value_or(amax);
+    if (!(zlo < 0 && zhi > 0) && !(amax == 0 && !hm.z_min && !hm.z_max))
+      throw_input(where, "heatmap limits", fmt::format("[{:g}, {:g}]", zlo, zhi), "must bracket 0", "z_min < 0 < z_max");
+    if (amax == 0 && !hm.z_min && !hm.z_max) { zlo = -1; zhi = 1; }
   }
   if (spec.log_x && ((spec.x_min && *spec.x_min <= 0) || (spec.x_max && *spec.x_max <= 0)))
     throw_input(where, "x limits", "", "not positive on a log axis");
@@ -240,7 +284,21 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
   for (const auto& l : ylab) ylabel_w = std::max(ylabel_w, text_width(cr, l));
 
   const double left = 0.9 * fs + ylabel_w + fs * 1.8;
-  const double right = fs * 1.5;
+  // Room for the colour bar: a gap, the bar, its tick labels and its rotated label.
+  std::vector<double> zt;
+  std::vector<std::string> zlab;
+  double zlab_w = 0;
+  if (spec.heatmap) {
+    zt = nice_ticks(zlo, zhi, 6);
+    zlab = tick_labels(zt, false);
+    if (!zt.empty()) {
+      if (zt.front() <= zlo) zlab.front() = "<=" + zlab.front();
+      if (zt.back() >= zhi) zlab.back() = ">=" + zlab.back();
+    }
+    for (const auto& l : zlab) zlab_w = std::max(zlab_w, text_width(cr, l));
+  }
+  const double bar_w = fs * 1.1;
+  const double right = spec.heatmap ? fs * 1.2 + bar_w + fs * 0.5 + zlab_w + fs * 2.0 : fs * 1.5;
   const double top = spec.title.empty() ? fs * 1.2 : fs * 2.6;
   const double bottom = fs * 4.0;
   const double pw = W - left - right, ph = H - top - bottom;
@@ -248,6 +306,58 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
 
   auto px = [&](double x) { return left + (ax.t(x) - ax.tlo()) / (ax.thi() - ax.tlo()) * pw; };
   auto py = [&](double y) { return top + ph - (ay.t(y) - ay.tlo()) / (ay.thi() - ay.tlo()) * ph; };
+
+  // Heat-map cells (under the grid lines) and the colour bar.
+  if (spec.heatmap) {
+    const Heatmap& hm = *spec.heatmap;
+    const std::size_t nx = hm.x.size();
+    auto tcol = [&](double z) { return z < 0 ? z / -zlo : z / zhi; };  // z in units of its side's limit, signed
+    cairo_save(cr);
+    cairo_rectangle(cr, left, top, pw, ph);
+    cairo_clip(cr);
+    for (std::size_t j = 0; j < hm.y.size(); ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        const double z = hm.z[j * nx + i];
+        if (!std::isfinite(z)) continue;
+        const auto c = diverging_colour(tcol(z));
+        cairo_set_source_rgb(cr, c[0], c[1], c[2]);
+        const double X0 = px(hx_edges[i]), X1 = px(hx_edges[i + 1]);
+        const double Y0 = py(hy_edges[j + 1]), Y1 = py(hy_edges[j]);
+        // Overdraw by half a pixel so neighbouring cells leave no hairline gaps.
+        cairo_rectangle(cr, X0 - 0.25, Y0 - 0.25, X1 - X0 + 0.5, Y1 - Y0 + 0.5);
+        cairo_fill(cr);
+      }
+    cairo_restore(cr);
+    const double bx = left + pw + fs * 1.2;
+    const int steps = 200;
+    for (int k = 0; k < steps; ++k) {
+      const double z = zlo + (zhi - zlo) * (k + 0.5) / steps;
+      const auto c = diverging_colour(tcol(z));
+      cairo_set_source_rgb(cr, c[0], c[1], c[2]);
+      cairo_rectangle(cr, bx, top + ph * (1.0 - static_cast<double>(k + 1) / steps), bar_w, ph / steps + 0.5);
+      cairo_fill(cr);
+    }
+    cairo_set_source_rgb(cr, 0, 0, 0);
+    cairo_set_line_width(cr, 1.0);
+    cairo_rectangle(cr, std::round(bx) + 0.5, std::round(top) + 0.5, std::round(bar_w), std::round(ph));
+    cairo_stroke(cr);
+    for (std::size_t k = 0; k < zt.size(); ++k) {
+      const double Y = std::round(top + ph * (1.0 - (zt[k] - zlo) / (zhi - zlo))) + 0.5;
+      cairo_move_to(cr, bx + bar_w, Y);
+      cairo_line_to(cr, bx + bar_w + fs * 0.3, Y);
+      cairo_stroke(cr);
+      show_text_at(cr, zlab[k], bx + bar_w + fs * 0.45, Y, 0.0, 0.5);
+    }
+    if (!hm.z_label.empty()) {
+      cairo_save(cr);
+      cairo_set_font_size(cr, fs);
+      cairo_translate(cr, W - fs * 0.4, top + ph / 2);
+      cairo_rotate(cr, M_PI / 2);
+      show_text_at(cr, hm.z_label, 0, 0, 0.5, 0.0);
+      cairo_restore(cr);
+      cairo_set_font_size(cr, fs * 0.85);
+    }
+  }
 
   // Grid and ticks.
   cairo_set_line_width(cr, 1.0);

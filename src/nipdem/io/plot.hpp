@@ -36,6 +36,19 @@ struct Series {
   std::optional<std::array<double, 3>> color;  // RGB in [0,1]; default from a palette
 };
 
+// A colour map drawn under the series (linear axes only): z[j * nx + i] is the value of the cell
+// centred at (x[i], y[j]); x and y strictly increasing, at least 2 each; cell edges lie halfway
+// between centres. NaN cells stay blank. Colours are diverging (blue < 0 < red, white at 0), made
+// for signed data such as a net force; the limits default to +-max|z|, each side of zero is scaled
+// to its own limit, and values beyond given limits take the end colours (display only; a tick at
+// a limit is labelled "<=" / ">="). A colour bar labelled `z_label` (with unit) is drawn right of
+// the plot.
+struct Heatmap {
+  std::vector<double> x, y, z;
+  std::string z_label;
+  std::optional<double> z_min, z_max;  // z_min < 0 < z_max when given
+};
+
 struct PlotSpec {
   std::string title;
   std::string x_label;            // with unit, e.g. "gap w_h [µm]"
@@ -47,11 +60,15 @@ struct PlotSpec {
   std::optional<double> x_min, x_max, y_min, y_max;  // axis limits (default: data range)
   bool legend = true;
   std::vector<Series> series;
+  std::optional<Heatmap> heatmap;  // drawn first; a plot may have a heat map and no series
 };
 
 // Renders `spec` and writes a PNG atomically. Throws InputError on bad data, std::runtime_error
 // if Cairo or the file system fails.
 void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec);
+
+// Diverging colour for t in [-1, 1] (clamped for display): blue at -1, white at 0, red at +1.
+std::array<double, 3> diverging_colour(double t);
 
 // Tick positions: "nice" values (1, 2, 2.5, 5 x 10^k) covering [lo, hi] with about
 // `target` intervals. Exposed for tests.
