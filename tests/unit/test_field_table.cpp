@@ -19,11 +19,6 @@ using namespace nipdem::experiments;
 
 namespace {
 
-ReachableRegion region_of(const NipConfig& c) {
-  return {c.x_min, c.x_max, {c.nip_x, -c.roller_radius}, {c.nip_x, c.gap + c.drum_radius}, c.roller_radius, c.drum_radius,
-          c.roughness ? c.rough_height : 0.0};
-}
-
 struct TableError {
   double max_rel = 0.0;  // max |F_table - F_exact| / max(|F_exact|, 1e-3 max|F_exact|)
   int points = 0;
@@ -36,7 +31,7 @@ struct TableError {
 TableError table_error(const NipConfig& c) {
   auto field = make_magnet_field(c.magnet);
   MagnetForce f(field, c.magnet);
-  const ReachableRegion r = region_of(c);
+  const ReachableRegion r = reachable_region(c);
   const double R = 0.5 * c.size.d50, h = 2.5e-6;
   std::vector<Vec2> ft, fe, pts;
   double fmax = 0.0;
@@ -148,7 +143,7 @@ TEST(FieldTable, WindowReachingIntoTheMagnetIsRefusedAtSetup) {
 // A field map must cover everything a toner centre can reach, pits included.
 TEST(FieldTable, MapThatDoesNotCoverThePitsIsRefused) {
   const auto c = parse_nip_config(preset_text("black"), "preset:black", {"output.vtk=false"});
-  const ReachableRegion r = region_of(c);
+  const ReachableRegion r = reachable_region(c);
   const auto knife = magnet::make_knife();
   const auto short_map = io::FieldMap::sample(knife, -0.7e-3, 0.7e-3, 57, 0.0, 160e-6, 9);  // from y = 0: no pits
   try {

@@ -22,8 +22,13 @@ namespace {
 constexpr int kPitFillFailures = 400;
 }  // namespace
 
-Vec2 NipRun::drum_centre() const { return {cfg_.nip_x, cfg_.gap + cfg_.drum_radius}; }
-Vec2 NipRun::roller_centre() const { return {cfg_.nip_x, -cfg_.roller_radius}; }
+ReachableRegion reachable_region(const NipConfig& c) {
+  return {c.x_min, c.x_max, {c.nip_x, -c.roller_radius}, {c.nip_x, c.gap + c.drum_radius}, c.roller_radius, c.drum_radius,
+          c.roughness ? c.rough_height : 0.0};
+}
+
+Vec2 NipRun::drum_centre() const { return reachable_region(cfg_).drum_centre; }
+Vec2 NipRun::roller_centre() const { return reachable_region(cfg_).roller_centre; }
 double NipRun::drum_surface_y(double x) const {
   const double dx = x - cfg_.nip_x;
   return drum_centre().y - std::sqrt(cfg_.drum_radius * cfg_.drum_radius - dx * dx);
@@ -61,9 +66,7 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   cfg_.magnet.threads = cfg_.threads;
   if (auto field = make_magnet_field(cfg_.magnet)) {
     // the field must be valid wherever a toner centre can go (refused at setup, not mid-run)
-    const ReachableRegion reach{cfg_.x_min, cfg_.x_max, roller_centre(), drum_centre(), cfg_.roller_radius, cfg_.drum_radius,
-                                cfg_.roughness ? cfg_.rough_height : 0.0};
-    check_field_region(*field, reach, fmt::format("{} (magnet.field = \"{}\")", cfg_.file.empty() ? "config" : cfg_.file, cfg_.magnet.field));
+    check_field_region(*field, reachable_region(cfg_), fmt::format("{} (magnet.field = \"{}\")", cfg_.file.empty() ? "config" : cfg_.file, cfg_.magnet.field));
     sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
   }
   if (cfg_.electric.enabled) {

@@ -122,4 +122,8 @@ class NipRun {
   std::shared_ptr<ElectricForce> electric_;
 };
 
+// Where a toner centre can go in the nip `c` describes (the window, from the roller surface less
+// the pit depth to the drum): what the magnet field must be valid over (check_field_region).
+ReachableRegion reachable_region(const NipConfig& c);
+
 }  // namespace nipdem::experiments
