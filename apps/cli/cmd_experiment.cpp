@@ -133,7 +133,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sub->add_option("--pits", k->reduction.pits, "sleeve pits entering upstream: empty (clean sleeve), filled, or preset")->capture_default_str();
     auto sweep = std::make_shared<std::string>();
     auto range = std::make_shared<std::string>();
-    sub->add_option("--from-sweep", *sweep, "no runs: fit r to the removed counts of a finished `experiment reduction` JSON (seeds = repeated r; docs/reduction.md)");
+    sub->add_option("--from-sweep", *sweep, "no runs: fit r to the removed counts of finished `experiment reduction` JSONs (comma-separated files of one preset and model are pooled; seeds = repeated r; docs/reduction.md)");
     sub->add_option("--target-range", *range, "with --from-sweep: LO:HI of the measured speed [m/s] (Table 4.3's three experiments: black 7.4e-4:7.8e-4, colour 2.0e-4:2.9e-4)");
     sub->callback([=] {
       if (sweep->empty()) {

@@ -2,9 +2,17 @@
 // reduction speeds, on analytic v(r) whose root is known.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/calibrate_cohesion.hpp"
@@ -200,4 +208,45 @@ TEST(CohesionCounts, BadInputIsRefusedNamingTheKey) {
   CountTarget bad = t;
   bad.speed_lo = 9e-4;  // above the speed
   EXPECT_NE(msg({{0.0, 5, 600}, {1.0, 6, 600}}, bad).find("--target-range"), std::string::npos);
+}
+
+// Sweeps run separately (one per seed) are pooled by --from-sweep A,B: the rows then hold both
+// seeds; sweeps of another preset or model are refused naming the file.
+TEST(CohesionCounts, FromSweepPoolsSeveralFilesOfOneModelAndRefusesMixedOnes) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("nipdem_cohesion_pool_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  auto sweep = [&](const char* name, const char* preset, std::vector<std::pair<double, double>> r_removed) {
+    nlohmann::json pts = nlohmann::json::array();
+    for (auto [r, n] : r_removed) pts.push_back({{"r", r}, {"removed", n}, {"initial_particles", 600}, {"time_s", 0.1}});
+    nlohmann::json j{{"experiment", "reduction"}, {"pile_width_m", 400e-6}, {"points", pts},
+                     {"meta", {{"preset", preset}, {"set", {"adhesion.roller_force_N=1e-8"}}, {"config", ""}}}};
+    std::ofstream(dir / name) << j.dump();
+    return (dir / name).string();
+  };
+  const std::string a = sweep("a.json", "black", {{0, 200}, {1, 150}, {3, 60}});
+  const std::string b = sweep("b.json", "black", {{0, 180}, {1, 130}, {3, 80}});
+  const std::string c = sweep("c.json", "color", {{0, 50}, {1, 20}, {3, 0}});
+  experiments::ExperimentOptions o;
+  o.out = dir / "out";
+  o.progress = false;
+  fs::create_directories(o.out);
+  const CountTarget t{7.6e-4, 7.4e-4, 7.8e-4, 0.1, 400e-6};
+  const auto j = calibrate_cohesion_from_sweep(o, a + "," + b, t);
+  ASSERT_EQ(j["rows"].size(), 3u);
+  EXPECT_EQ(j["rows"][1]["seeds"].get<int>(), 2);
+  EXPECT_DOUBLE_EQ(j["rows"][1]["removed_mean"].get<double>(), 140.0);
+  EXPECT_NEAR(j["rows"][1]["removed_stderr"].get<double>(), 10.0, 1e-12);  // sd 10 sqrt(2) / sqrt(2)
+  ASSERT_TRUE(j.contains("r_fit"));
+  EXPECT_NEAR(j["r_fit"].get<double>(), 1.0 + 2.0 * (140.0 - 114.0) / (140.0 - 70.0), 1e-9);  // linear 1 -> 3
+  EXPECT_EQ(j["sweeps"].size(), 2u);
+  try {
+    calibrate_cohesion_from_sweep(o, a + "," + c, t);
+    ADD_FAILURE() << "a colour sweep was pooled with a black one";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("c.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("preset"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(calibrate_cohesion_from_sweep(o, a + ",", t), InputError);
+  fs::remove_all(dir);
 }

@@ -190,30 +190,56 @@ CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const C
   return f;
 }
 
-json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& file, const CountTarget& target) {
-  json rep;
-  try {
-    rep = json::parse(io::read_file(file));
-  } catch (const json::exception& e) {
-    throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
+json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& file_list, const CountTarget& target) {
+  // Several sweeps (e.g. one per seed, run separately) are pooled: comma-separated files of the
+  // same preset, model (--set overrides) and observation time.
+  std::vector<std::string> files;
+  for (std::size_t a = 0; a <= file_list.size();) {
+    const std::size_t b = std::min(file_list.find(',', a), file_list.size());
+    if (b == a) throw_input("calibrate cohesion", "--from-sweep", file_list, "empty file name in the comma-separated list");
+    files.push_back(file_list.substr(a, b - a));
+    a = b + 1;
   }
-  if (!rep.is_object() || rep.value("experiment", std::string()) != "reduction" || !rep.contains("points") || !rep["points"].is_array())
-    throw_input(file, "experiment", "", "expected the JSON written by `nipdem experiment reduction` (\"experiment\": \"reduction\", \"points\": [...])");
   std::vector<CountPoint> pts;
-  double T = -1.0;
-  std::size_t k = 0;
-  for (const auto& p : rep["points"]) {
-    for (const char* key : {"r", "removed", "initial_particles", "time_s"})
-      if (!p.contains(key) || !p[key].is_number()) throw_input(file, fmt::format("points[{}].{}", k, key), "", "missing or not a number");
-    const double tk = p["time_s"].get<double>();
-    if (T < 0.0) T = tk;
-    if (std::abs(tk - T) > 1e-6 * T) throw_input(file, fmt::format("points[{}].time_s", k), fmt::format("{:g}", tk), fmt::format("every point must have the same observation time ({:g} s)", T));
-    pts.push_back({p["r"].get<double>(), p["removed"].get<double>(), p["initial_particles"].get<double>()});
-    ++k;
+  double T = -1.0, width = -1.0;
+  json first_meta;
+  for (const auto& file : files) {
+    json rep;
+    try {
+      rep = json::parse(io::read_file(file));
+    } catch (const json::exception& e) {
+      throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
+    }
+    if (!rep.is_object() || rep.value("experiment", std::string()) != "reduction" || !rep.contains("points") || !rep["points"].is_array())
+      throw_input(file, "experiment", "", "expected the JSON written by `nipdem experiment reduction` (\"experiment\": \"reduction\", \"points\": [...])");
+    if (rep.contains("meta") && rep["meta"].is_object()) {
+      json m = json::object();
+      for (const char* key : {"preset", "set", "config"})
+        if (rep["meta"].contains(key)) m[key] = rep["meta"][key];
+      if (first_meta.is_null()) first_meta = m;
+      else if (m != first_meta)
+        throw_input(file, "meta", m.dump(), fmt::format("every pooled sweep must have the same preset, config and --set overrides as {} ({})", files.front(), first_meta.dump()));
+    }
+    if (rep.contains("pile_width_m") && rep["pile_width_m"].is_number()) {
+      const double w = rep["pile_width_m"].get<double>();
+      if (width < 0.0) width = w;
+      else if (std::abs(w - width) > 1e-9 * width) throw_input(file, "pile_width_m", fmt::format("{:g}", w), fmt::format("every pooled sweep must have the same pile width ({:g} m)", width));
+    }
+    std::size_t k = 0;
+    for (const auto& p : rep["points"]) {
+      for (const char* key : {"r", "removed", "initial_particles", "time_s"})
+        if (!p.contains(key) || !p[key].is_number()) throw_input(file, fmt::format("points[{}].{}", k, key), "", "missing or not a number");
+      const double tk = p["time_s"].get<double>();
+      if (T < 0.0) T = tk;
+      if (std::abs(tk - T) > 1e-6 * T) throw_input(file, fmt::format("points[{}].time_s", k), fmt::format("{:g}", tk), fmt::format("every point must have the same observation time ({:g} s)", T));
+      pts.push_back({p["r"].get<double>(), p["removed"].get<double>(), p["initial_particles"].get<double>()});
+      ++k;
+    }
   }
+  const std::string file = file_list;
   CountTarget t = target;
   t.time_s = T > 0.0 ? T : t.time_s;
-  if (rep.contains("pile_width_m") && rep["pile_width_m"].is_number()) t.pile_width_m = rep["pile_width_m"].get<double>();
+  if (width > 0.0) t.pile_width_m = width;
   const CountFit f = fit_cohesion_from_counts(pts, t);
 
   std::string csv = "r,seeds,removed_mean,removed_stderr\n";
@@ -258,6 +284,7 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
   json j{{"calibration", "cohesion"},
          {"method", "counts from a reduction sweep"},
          {"sweep", file},
+         {"sweeps", files},
          {"target_speed_m_per_s", t.speed},
          {"target_speed_range_m_per_s", {t.speed_lo, t.speed_hi}},
          {"observation_time_s", t.time_s},
