@@ -2,6 +2,8 @@
 // rest) must find the same features as direct trigonometry per vertex.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "nipdem/core/rng.hpp"
@@ -22,6 +24,7 @@ TEST(WallQuery, PreparedRotationsEqualDirectTrigonometry) {
   int hits_total = 0;
   for (double angle : {0.0, 0.3, -2.1, 1e3}) {  // large angles: the roller has turned many times
     w.angle = direct.angle = angle;
+    w.prepare_angle();  // the engine's per-evaluation cache: the roller-frame table path
     for (int i = 0; i < 2000; ++i) {
       // points from 20 um inside to 20 um outside the base circle, all around the roller
       const double phi = rng.uniform(0.0, 6.283185307179586), rr = w.radius + rng.uniform(-20e-6, 20e-6);
@@ -45,4 +48,73 @@ TEST(WallQuery, PreparedRotationsEqualDirectTrigonometry) {
     }
   }
   EXPECT_GT(hits_total, 1000);  // the sample does exercise contacts
+}
+
+// Every feature of every period, by direct trigonometry (independent of query()'s choice of
+// which periods to look at): segment interiors and convex vertices within reach.
+static std::vector<geometry::WallHit> all_features(const geometry::Wall& w, Vec2 c, double r, double reach) {
+  std::vector<geometry::WallHit> out;
+  const int m = static_cast<int>(w.profile.size()) - 1;
+  const double P = w.period();
+  for (int k = 0; k < w.n_periods; ++k) {
+    for (int j = 0; j < m; ++j) {
+      const Vec2 a = w.profile_point(k, w.profile[j]), b = w.profile_point(k, w.profile[j + 1]);
+      const Vec2 ab = b - a;
+      const double t = dot(c - a, ab) / norm2(ab);
+      if (t <= 0.0 || t >= 1.0) continue;
+      const Vec2 q = a + t * ab;
+      const double gap = norm(c - q) - r;
+      if (gap <= reach) out.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, {}, gap, {}});
+    }
+    for (int j = 0; j < m; ++j) {
+      const Vec2 prev = j == 0 ? Vec2{w.profile[m - 1].x - P, w.profile[m - 1].y} : w.profile[j - 1];
+      if (cross(w.profile[j] - prev, w.profile[j + 1] - w.profile[j]) <= 0.0) continue;
+      const Vec2 v = w.profile_point(k, w.profile[j]);
+      const double gap = norm(c - v) - r;
+      if (gap <= reach) out.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, {}, gap, {}});
+    }
+  }
+  return out;
+}
+
+// query() looks only at the periods that can reach the disc (bound in walls.cpp); it must
+// still find every feature within reach, for discs on the lands, in the pits (centres down to
+// the pit bottom) and at the period boundaries, and nothing else.
+TEST(WallQuery, FindsEveryFeatureWithinReachOfAllPeriods) {
+  geometry::Wall w;
+  w.kind = geometry::Wall::Kind::cylinder;
+  w.name = "roller";
+  w.centre = {0.0, -0.02};
+  w.radius = 0.02;
+  geometry::set_pyramid_roughness(w, 15e-6, 50e-6, 20e-6);
+  Rng rng(11);
+  int hits_total = 0, two_period = 0;
+  for (double angle : {0.0, 0.77, -31.4}) {
+    w.angle = angle;
+    w.prepare_angle();
+    for (int i = 0; i < 400; ++i) {
+      const double phi = 1.5707963267948966 + rng.uniform(-3e-3, 3e-3);  // near the top: +-60 um of arc
+      const double rr = w.radius + rng.uniform(-16e-6, 10e-6);
+      const Vec2 c = w.centre + Vec2{rr * std::cos(phi), rr * std::sin(phi)};
+      const double r = rng.uniform(2e-6, 8e-6), reach = rng.uniform(0.0, 2e-6);
+      std::vector<geometry::WallHit> got;
+      w.query(c, r, reach, got);
+      auto want = all_features(w, c, r, reach);
+      auto by_key = [](const geometry::WallHit& a, const geometry::WallHit& b) { return a.key < b.key; };
+      std::sort(got.begin(), got.end(), by_key);
+      std::sort(want.begin(), want.end(), by_key);
+      ASSERT_EQ(got.size(), want.size()) << "disc at (" << c.x << ", " << c.y << "), r = " << r;
+      std::int64_t periods_seen = 0, last = -1;
+      for (std::size_t k = 0; k < got.size(); ++k) {
+        EXPECT_EQ(got[k].key, want[k].key);
+        EXPECT_NEAR(got[k].gap, want[k].gap, 2e-14);  // a few ulps of the 2 cm radius (see above)
+        const std::int64_t period = got[k].key / (2 * (static_cast<std::int64_t>(w.profile.size()) - 1));
+        if (period != last) { ++periods_seen; last = period; }
+      }
+      hits_total += static_cast<int>(got.size());
+      two_period += periods_seen > 1;
+    }
+  }
+  EXPECT_GT(hits_total, 300);
+  EXPECT_GT(two_period, 5);  // discs straddling a period boundary are in the sample
 }

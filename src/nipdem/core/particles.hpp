@@ -11,6 +11,9 @@ namespace nipdem {
 struct BodyStore {
   // Kinematics of the centre of mass [m, m/s, rad, rad/s].
   std::vector<double> x, y, vx, vy, theta, omega;
+  // cos/sin of theta, advanced with it by a rotation each step (no per-step trigonometry);
+  // the disc placement reads these, theta is the accumulated angle for output.
+  std::vector<double> cth, sth;
   // Total force [N] and torque about the centre of mass [N m] from the last force evaluation.
   std::vector<double> fx, fy, torque;
   std::vector<double> mass, inertia;     // [kg], [kg m^2] about the centre of mass (z axis)

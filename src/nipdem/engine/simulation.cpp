@@ -19,6 +19,29 @@ namespace nipdem::engine {
 using models::ContactParams;
 using models::TangentialState;
 
+namespace {
+// Rotates the unit vector (c, s) = (cos theta, sin theta) by the step's angle d: for the small
+// angles of a DEM step (|d| <= 1e-2 rad) by the Taylor series of cos d and sin d (truncation
+// below 3e-21, i.e. exact in double precision), else by libm; then one Newton step towards
+// c^2 + s^2 = 1, so rounding does not accumulate in the length. Same state, same result:
+// the engine stays bitwise reproducible and resumable (c, s are checkpointed).
+inline void rotate_by(double& c, double& s, double d) {
+  double cd, sd;
+  if (std::fabs(d) <= 1e-2) {
+    const double d2 = d * d;
+    cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+    sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+  } else {
+    cd = std::cos(d);
+    sd = std::sin(d);
+  }
+  const double c1 = c * cd - s * sd, s1 = s * cd + c * sd;
+  const double f = 1.5 - 0.5 * (c1 * c1 + s1 * s1);
+  c = c1 * f;
+  s = s1 * f;
+}
+}  // namespace
+
 Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
     : params_(std::move(params)), walls_(std::move(walls)) {
   if (params_.interactions.empty()) throw_input("engine", "interactions", "", "at least the disc-disc interaction is required");
@@ -67,6 +90,7 @@ int Simulation::add_body(const BodySpec& s) {
   b_.x.push_back(s.position.x); b_.y.push_back(s.position.y);
   b_.vx.push_back(s.velocity.x); b_.vy.push_back(s.velocity.y);
   b_.theta.push_back(s.angle); b_.omega.push_back(s.omega);
+  b_.cth.push_back(std::cos(s.angle)); b_.sth.push_back(std::sin(s.angle));
   b_.fx.push_back(0.0); b_.fy.push_back(0.0); b_.torque.push_back(0.0);
   b_.mass.push_back(m); b_.inertia.push_back(inertia);
   b_.id.push_back(next_id_++);
@@ -107,6 +131,7 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   auto move_body = [&](std::size_t from, std::size_t to) {
     b_.x[to] = b_.x[from]; b_.y[to] = b_.y[from]; b_.vx[to] = b_.vx[from]; b_.vy[to] = b_.vy[from];
     b_.theta[to] = b_.theta[from]; b_.omega[to] = b_.omega[from];
+    b_.cth[to] = b_.cth[from]; b_.sth[to] = b_.sth[from];
     b_.fx[to] = b_.fx[from]; b_.fy[to] = b_.fy[from]; b_.torque[to] = b_.torque[from];
     b_.mass[to] = b_.mass[from]; b_.inertia[to] = b_.inertia[from]; b_.id[to] = b_.id[from];
     b_.n_discs[to] = b_.n_discs[from]; b_.tag[to] = b_.tag[from]; b_.size[to] = b_.size[from];
@@ -139,8 +164,8 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
     ++bw;
   }
   auto shrink = [](auto& v, std::size_t n) { v.resize(n); };
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
-                  &b_.inertia, &b_.size}) shrink(*v, bw);
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
+                  &b_.mass, &b_.inertia, &b_.size}) shrink(*v, bw);
   shrink(b_.id, bw); shrink(b_.first_disc, bw); shrink(b_.n_discs, bw); shrink(b_.tag, bw);
   for (auto& v : prov_fx_) v.resize(bw);
   for (auto& v : prov_fy_) v.resize(bw);
@@ -171,7 +196,7 @@ inline void Simulation::place_body(std::size_t b) {
     d_.x[first] = X; d_.y[first] = Y; d_.wx[first] = 0.0; d_.wy[first] = 0.0;
     return;
   }
-  const double c = std::cos(b_.theta[b]), s = std::sin(b_.theta[b]);
+  const double c = b_.cth[b], s = b_.sth[b];
   for (int k = first; k < first + nd; ++k) {
     const double wx = c * d_.ox[k] - s * d_.oy[k];
     const double wy = s * d_.ox[k] + c * d_.oy[k];
@@ -187,6 +212,7 @@ void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
 // moved: -1 = unknown (check every disc), 0/1 = the caller already checked (step() does it
 // in the drift loop).
 void Simulation::ensure_neighbor_list(int moved) {
+  nl_params_.threads = params_.threads;
   if (structure_changed_) {
     nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
   } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
@@ -382,6 +408,7 @@ void Simulation::contact_forces() {
 void Simulation::prepare_walls() {
   const std::size_t nw = walls_.size();
   wall_reach_.resize(nw);
+  for (auto& w : walls_) w.prepare_angle();  // one sin/cos per wall and evaluation, not per query
   for (std::size_t w = 0; w < nw; ++w) {
     const auto& ad = params_.interactions[walls_[w].interaction].adhesion;
     wall_reach_[w] = ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0;
@@ -505,24 +532,33 @@ void Simulation::step() {
   const bool check_moves = !structure_changed_ && nlist_.size() == d_.x.size();
   double* x = b_.x.data(); double* y = b_.y.data(); double* vx = b_.vx.data(); double* vy = b_.vy.data();
   double* th = b_.theta.data(); double* om = b_.omega.data();
+  double* cth = b_.cth.data(); double* sth = b_.sth.data();
   const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
   const double* m = b_.mass.data(); const double* I = b_.inertia.data();
-  int moved = 0;
-  // One pass per body: integrate, wrap, place its discs and check them against the list's
-  // skin (instead of three separate passes over all bodies/discs).
-#pragma omp parallel for schedule(static) num_threads(params_.threads) reduction(| : moved)
+  // One pass per body: integrate, wrap, place its discs and track the two largest disc
+  // displacements since the list was built (instead of three separate passes).
+  const int nt = params_.threads;
+  thread_disp_.assign(2 * nt, 0.0);
+#pragma omp parallel num_threads(nt)
+  {
+  double d1 = 0.0, d2 = 0.0;
+#pragma omp for schedule(static)
   for (std::size_t b = 0; b < nb; ++b) {
+    double dth;
     if (newmark) {
       // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
       const double ax = fx[b] / m[b], ay = fy[b] / m[b], al = tq[b] / I[b];
       x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
-      th[b] += dt * om[b] + 0.5 * dt * dt * al;
+      dth = dt * om[b] + 0.5 * dt * dt * al;
       vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
     } else {
       // velocity Verlet, first half: kick by dt/2, drift by dt
       vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
-      x[b] += dt * vx[b]; y[b] += dt * vy[b]; th[b] += dt * om[b];
+      x[b] += dt * vx[b]; y[b] += dt * vy[b];
+      dth = dt * om[b];
     }
+    th[b] += dth;
+    rotate_by(cth[b], sth[b], dth);
     if (periodic) {  // a body moves far less than L per step
       x[b] = x[b] >= xhi ? x[b] - L : x[b];
       x[b] = x[b] < xlo ? x[b] + L : x[b];
@@ -530,8 +566,21 @@ void Simulation::step() {
     place_body(b);
     if (check_moves) {
       const int first = b_.first_disc[b], nd = b_.n_discs[b];
-      for (int k = first; k < first + nd; ++k) moved |= nlist_.moved(k, d_.x[k], d_.y[k]);
+      for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
     }
+  }
+  const int t = omp_get_thread_num();
+  thread_disp_[2 * t] = d1;
+  thread_disp_[2 * t + 1] = d2;
+  }
+  int moved = 0;
+  if (check_moves) {
+    double d1 = 0.0, d2 = 0.0;
+    for (int t = 0; t < nt; ++t) {
+      geometry::NeighborList::top2(thread_disp_[2 * t], d1, d2);
+      geometry::NeighborList::top2(thread_disp_[2 * t + 1], d1, d2);
+    }
+    moved = nlist_.exceeds(d1, d2) ? 1 : 0;
   }
   for (auto& w : walls_) w.advance(dt);
   time_ += dt;
@@ -596,8 +645,8 @@ using binary::put_vec;
 void Simulation::save(std::ostream& o) const {
   put(o, kMagic);
   put(o, time_); put(o, step_); put(o, next_id_);
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
-                  &b_.inertia, &b_.size}) put_vec(o, *v);
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
+                  &b_.mass, &b_.inertia, &b_.size}) put_vec(o, *v);
   put_vec(o, b_.id); put_vec(o, b_.first_disc); put_vec(o, b_.n_discs); put_vec(o, b_.tag);
   for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
     put_vec(o, *v);
@@ -618,8 +667,8 @@ void Simulation::load(std::istream& in) {
   get(in, magic);
   if (magic != kMagic) throw std::runtime_error("not a nipdem checkpoint (bad magic)");
   get(in, time_); get(in, step_); get(in, next_id_);
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.fx, &b_.fy, &b_.torque, &b_.mass,
-                  &b_.inertia, &b_.size}) get_vec(in, *v);
+  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
+                  &b_.mass, &b_.inertia, &b_.size}) get_vec(in, *v);
   get_vec(in, b_.id); get_vec(in, b_.first_disc); get_vec(in, b_.n_discs); get_vec(in, b_.tag);
   for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
     get_vec(in, *v);

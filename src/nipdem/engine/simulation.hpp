@@ -167,6 +167,7 @@ class Simulation {
   // only that window of its buffer is zeroed and reduced.
   std::vector<int> split_, reach_hi_;
   std::vector<std::int64_t> thread_nc_;
+  std::vector<double> thread_disp_;  // per thread: two largest squared disc displacements
   int split_builds_ = -1, split_threads_ = 0;
   std::vector<std::vector<geometry::WallHit>> thread_hits_;  // per-thread wall query scratch
   std::vector<double> wall_reach_;                          // adhesion reach of each wall [m]

@@ -4,35 +4,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <omp.h>
+
 namespace nipdem::geometry {
 
 bool NeighborList::needs_rebuild(std::span<const double> x, std::span<const double> y) const {
   if (x.size() != x0_.size()) return true;
-  // Called every step: no libm call (nearbyint is not inlined without SSE4.1) and no early
-  // exit inside the loop, so it vectorises; a moved disc is rare.
-  const std::size_t n = x.size();
-  const double* px = x.data(); const double* py = y.data();
-  const double* qx = x0_.data(); const double* qy = y0_.data();
-  const double L = params_.x_hi - params_.x_lo, hL = 0.5 * L;
-  const bool periodic = params_.periodic_x;
-  const double lim = half_skin2_;
-  bool moved = false;
-  constexpr std::size_t kBlock = 256;
-  for (std::size_t b0 = 0; b0 < n && !moved; b0 += kBlock) {
-    const std::size_t b1 = std::min(n, b0 + kBlock);
-    int any = 0;
-    for (std::size_t i = b0; i < b1; ++i) {
-      double dx = px[i] - qx[i];
-      const double dy = py[i] - qy[i];
-      if (periodic) {  // a disc that crossed the periodic boundary moved by about +-L
-        dx = dx > hL ? dx - L : dx;
-        dx = dx < -hL ? dx + L : dx;
-      }
-      any |= (dx * dx + dy * dy > lim);
-    }
-    moved = any != 0;
-  }
-  return moved;
+  double d1 = 0.0, d2 = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) top2(displacement2(i, x[i], y[i]), d1, d2);
+  return exceeds(d1, d2);
 }
 
 void NeighborList::rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,
@@ -40,7 +20,7 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
                            const NeighborListParams& p) {
   const std::size_t n = x.size();
   params_ = p;
-  half_skin2_ = 0.25 * p.skin * p.skin;
+  skin_ = p.skin;
   ++builds_;
   new_start_.assign(n + 1, 0);
   new_nbr_.clear();
@@ -90,57 +70,78 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     cell_next_[ii] = cell_head_[c];
     cell_head_[c] = static_cast<int>(ii);
   }
-  std::vector<int> row;  // reused per row (small)
-  row.reserve(64);
+  // Rows are searched in parallel, each thread over one contiguous range of rows into its own
+  // buffers, then concatenated in order: the list is the same for any thread count.
+  const int nt = std::max(1, std::min(p.threads, static_cast<int>(n / 1024) + 1));
+  if (static_cast<int>(rows_.size()) < nt) rows_.resize(nt);
   const bool has_old = !old_of_new.empty();
-  for (std::size_t i = 0; i < n; ++i) {
-    row.clear();
-    const int cx = cell_x(x[i]), cy = cell_y(y[i]);
-    for (int dyc = -1; dyc <= 1; ++dyc) {
-      const int yy = cy + dyc;
-      if (yy < 0 || yy >= ny) continue;
-      for (int dxc = -1; dxc <= 1; ++dxc) {
-        int xx = cx + dxc;
-        if (p.periodic_x) {
-          if (nx < 3 && dxc != 0 && (xx < 0 || xx >= nx)) { /* tiny box: wrap duplicates filtered below */ }
-          xx = ((xx % nx) + nx) % nx;
-        } else if (xx < 0 || xx >= nx) {
-          continue;
-        }
-        for (int j = cell_head_[yy * nx + xx]; j >= 0; j = cell_next_[j]) {
-          if (j <= static_cast<int>(i) || body[j] == body[i]) continue;
-          double dx = x[j] - x[i], dy = y[j] - y[i];
-          if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
-          const double rc = r[i] + r[j] + reach;
-          if (dx * dx + dy * dy < rc * rc) row.push_back(j);
-        }
-      }
-    }
-    std::sort(row.begin(), row.end());
-    row.erase(std::unique(row.begin(), row.end()), row.end());
-    for (int j : row) {
-      new_nbr_.push_back(j);
-      double eta = 0.0;
-      std::uint8_t sl = 0;
-      // Carry history over: find the pair in the old list (row min(oi,oj), sorted).
-      int oi = static_cast<int>(i), oj = j;
-      if (has_old) { oi = old_of_new[i]; oj = old_of_new[j]; }
-      if (oi >= 0 && oj >= 0 && !row_start_.empty()) {
-        const int a = std::min(oi, oj), b = std::max(oi, oj);
-        if (static_cast<std::size_t>(a) + 1 < row_start_.size()) {
-          auto first = nbr_.begin() + row_start_[a], last = nbr_.begin() + row_start_[a + 1];
-          auto it = std::lower_bound(first, last, b);
-          if (it != last && *it == b) {
-            const auto k = static_cast<std::size_t>(it - nbr_.begin());
-            eta = eta_[k];
-            sl = slide_[k];
+  const bool has_prev = !row_start_.empty();
+  for (int t = 0; t < nt; ++t) { rows_[t].nbr.clear(); rows_[t].eta.clear(); rows_[t].slide.clear(); }
+#pragma omp parallel num_threads(nt) if (nt > 1)
+  {
+    const int T = omp_get_num_threads(), t = omp_get_thread_num();
+    const std::size_t i_lo = n * t / T, i_hi = n * (t + 1) / T;
+    Rows& out = rows_[t];
+    std::vector<int>& row = out.row;
+    for (std::size_t i = i_lo; i < i_hi; ++i) {
+      row.clear();
+      const int cx = cell_x(x[i]), cy = cell_y(y[i]);
+      for (int dyc = -1; dyc <= 1; ++dyc) {
+        const int yy = cy + dyc;
+        if (yy < 0 || yy >= ny) continue;
+        for (int dxc = -1; dxc <= 1; ++dxc) {
+          int xx = cx + dxc;
+          if (p.periodic_x) {
+            xx = ((xx % nx) + nx) % nx;  // tiny boxes (nx < 3) give duplicates, removed below
+          } else if (xx < 0 || xx >= nx) {
+            continue;
+          }
+          for (int j = cell_head_[yy * nx + xx]; j >= 0; j = cell_next_[j]) {
+            if (j <= static_cast<int>(i) || body[j] == body[i]) continue;
+            double dx = x[j] - x[i], dy = y[j] - y[i];
+            if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
+            const double rc = r[i] + r[j] + reach;
+            if (dx * dx + dy * dy < rc * rc) row.push_back(j);
           }
         }
       }
-      new_eta_.push_back(eta);
-      new_slide_.push_back(sl);
+      std::sort(row.begin(), row.end());
+      row.erase(std::unique(row.begin(), row.end()), row.end());
+      for (int j : row) {
+        out.nbr.push_back(j);
+        double eta = 0.0;
+        std::uint8_t sl = 0;
+        // Carry history over: find the pair in the old list (row min(oi,oj), sorted).
+        int oi = static_cast<int>(i), oj = j;
+        if (has_old) { oi = old_of_new[i]; oj = old_of_new[j]; }
+        if (oi >= 0 && oj >= 0 && has_prev) {
+          const int a = std::min(oi, oj), b = std::max(oi, oj);
+          if (static_cast<std::size_t>(a) + 1 < row_start_.size()) {
+            auto first = nbr_.begin() + row_start_[a], last = nbr_.begin() + row_start_[a + 1];
+            auto it = std::lower_bound(first, last, b);
+            if (it != last && *it == b) {
+              const auto k = static_cast<std::size_t>(it - nbr_.begin());
+              eta = eta_[k];
+              sl = slide_[k];
+            }
+          }
+        }
+        out.eta.push_back(eta);
+        out.slide.push_back(sl);
+      }
+      new_start_[i + 1] = static_cast<int>(row.size());  // count now, offset below
     }
-    new_start_[i + 1] = static_cast<int>(new_nbr_.size());
+  }
+  for (std::size_t i = 0; i < n; ++i) new_start_[i + 1] += new_start_[i];
+  new_nbr_.resize(new_start_[n]);
+  new_eta_.resize(new_start_[n]);
+  new_slide_.resize(new_start_[n]);
+  for (int t = 0, off = 0; t < nt; ++t) {
+    const Rows& part = rows_[t];
+    std::copy(part.nbr.begin(), part.nbr.end(), new_nbr_.begin() + off);
+    std::copy(part.eta.begin(), part.eta.end(), new_eta_.begin() + off);
+    std::copy(part.slide.begin(), part.slide.end(), new_slide_.begin() + off);
+    off += static_cast<int>(part.nbr.size());
   }
   row_start_.swap(new_start_);
   nbr_.swap(new_nbr_);

@@ -3,6 +3,7 @@
 // its contact history (tangential stretch, sliding flag) so the pair loop has no lookups.
 // History survives rebuilds and renumbering (bodies removed/added): see rebuild().
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -14,6 +15,7 @@ struct NeighborListParams {
   double extra_range = 0.0;     // interaction range beyond touching (adhesion cut-off) [m]
   bool periodic_x = false;      // minimum-image convention along x
   double x_lo = 0.0, x_hi = 0.0;  // periodic box along x [m] (used if periodic_x)
+  int threads = 1;              // OpenMP threads for the row search (same list for any count)
 };
 
 class NeighborList {
@@ -25,12 +27,14 @@ class NeighborList {
   void rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,
                std::span<const int> body, std::span<const int> old_of_new, const NeighborListParams& p);
 
-  // True if some disc moved more than skin/2 since the last build (then rebuild()).
+  // True if the list may miss a pair: the two largest displacements since the last build
+  // add up to more than the skin (no two discs can then have closed the skin between them;
+  // a plain max > skin/2 test rebuilds up to twice as often when a few discs move fast).
   bool needs_rebuild(std::span<const double> x, std::span<const double> y) const;
 
-  // Per-disc form of needs_rebuild() for fused loops: true if disc i, now at (x, y), moved
-  // more than skin/2 since the last build. Requires size() == number of discs.
-  bool moved(std::size_t i, double x, double y) const {
+  // Per-disc squared displacement since the last build, for fused loops that track the two
+  // largest themselves (then exceeds()). Requires size() == number of discs.
+  double displacement2(std::size_t i, double x, double y) const {
     double dx = x - x0_[i];
     const double dy = y - y0_[i];
     if (params_.periodic_x) {  // a disc that crossed the periodic boundary moved by about +-L
@@ -38,7 +42,15 @@ class NeighborList {
       dx = dx > 0.5 * L ? dx - L : dx;
       dx = dx < -0.5 * L ? dx + L : dx;
     }
-    return dx * dx + dy * dy > half_skin2_;
+    return dx * dx + dy * dy;
+  }
+  // True if the two largest squared displacements d1 >= d2 call for a rebuild.
+  bool exceeds(double d1, double d2) const { return std::sqrt(d1) + std::sqrt(d2) > skin_; }
+  // Folds squared displacement d into the running top two (d1 >= d2).
+  static void top2(double d, double& d1, double& d2) {
+    if (d > d2) {
+      if (d > d1) { d2 = d1; d1 = d; } else { d2 = d; }
+    }
   }
 
   std::size_t size() const { return row_start_.empty() ? 0 : row_start_.size() - 1; }
@@ -53,7 +65,7 @@ class NeighborList {
 
  private:
   std::vector<double> x0_, y0_;  // positions at the last build
-  double half_skin2_ = 0.0;
+  double skin_ = 0.0;
   NeighborListParams params_;
   int builds_ = 0;
   // scratch reused across builds (no per-step allocation)
@@ -61,6 +73,12 @@ class NeighborList {
   std::vector<int> new_start_, new_nbr_;
   std::vector<double> new_eta_;
   std::vector<std::uint8_t> new_slide_;
+  struct Rows {  // one thread's consecutive rows during a build
+    std::vector<int> nbr, row;
+    std::vector<double> eta;
+    std::vector<std::uint8_t> slide;
+  };
+  std::vector<Rows> rows_;
 };
 
 }  // namespace nipdem::geometry

@@ -1,5 +1,6 @@
 #include "nipdem/geometry/walls.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -57,20 +58,43 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   if (s < 0) s += circumference;
   const int k0 = static_cast<int>(std::floor(s / P));
   const int m = static_cast<int>(profile.size()) - 1;  // segments per period
+  // Only the periods whose features can lie within a = r + reach of the centre: a feature at
+  // distance rho >= rho_min from the axis and polar angle dphi from the centre's is at least
+  // 2 sqrt(dist rho) sin(|dphi|/2) away, so |dphi| <= 2 asin(x) <= 2 x (1 + x^2) with
+  // x = a / (2 sqrt(dist rho_min)), x <= 1/2. rho_min = radius - max depth - P also covers
+  // the chords between vertices. Period k0 - 1 ends (and k0 + 1 begins) at arc length
+  // k0 P (and (k0 + 1) P); skipping a period that cannot touch changes no result.
+  const double s_in = s - k0 * P;
+  bool need_prev = true, need_next = true;
+  const double rho_min = radius - max_depth_ - P;
+  if (rho_min > 0.0) {
+    const double x = (r + reach) / (2.0 * std::sqrt(dist * rho_min));
+    if (x <= 0.5) {
+      const double w = radius * 2.0 * x * (1.0 + x * x) * (1.0 + 1e-9) + 1e-12 * P;
+      need_prev = s_in <= w;
+      need_next = P - s_in <= w;
+    }
+  }
   // World positions of one period's profile vertices, computed once per period and shared
-  // by its segments and vertices (each costs a sin and a cos). Scratch grows once per thread.
+  // by its segments and vertices. Scratch grows once per thread.
   thread_local std::vector<Vec2> pts;
   if (pts.size() < profile.size()) pts.resize(profile.size());
-  const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P;
-  Vec2 u{};  // (cos, sin) of the polar angle of period k's s = 0
+  const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P &&
+                    prepared_phase_ == phase && static_cast<int>(period_units_.size()) == n_periods;
+  const bool fast_angle = fast && prepared_angle_ == angle;
   for (int dk = -1; dk <= 1; ++dk) {
+    if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
     const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
     if (fast) {
-      if (dk == -1) {
+      // (cos, sin) of the polar angle of period k's s = 0: the roller-frame table rotated by
+      // the roller's angle (no trigonometry when prepare_angle() saw this angle).
+      Vec2 u;
+      if (fast_angle) {
+        const Vec2 q = period_units_[k], a = angle_rotation_;
+        u = {a.x * q.x - a.y * q.y, a.x * q.y + a.y * q.x};
+      } else {
         const double base = (k * P + phase) / radius + angle;
         u = {std::cos(base), std::sin(base)};
-      } else {
-        u = {u.x * period_rotation_.x - u.y * period_rotation_.y, u.x * period_rotation_.y + u.y * period_rotation_.x};
       }
       for (int j = 0; j <= m; ++j) {
         const Vec2 e{u.x * unit_offsets_[j].x - u.y * unit_offsets_[j].y, u.x * unit_offsets_[j].y + u.y * unit_offsets_[j].x};
@@ -88,9 +112,12 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       // covered by the interiors of their two faces.
       if (t <= 0.0 || t >= 1.0) continue;
       const Vec2 dq = c - q;
-      const double dd = norm(dq);
+      const double dd2 = norm2(dq);
+      const double lim = r + reach;
+      if (dd2 > lim * lim || dd2 <= 0.0) continue;  // cheap reject before the square root
+      const double dd = std::sqrt(dd2);
       const double gap = dd - r;
-      if (gap > reach || dd <= 0.0) continue;
+      if (gap > reach) continue;
       hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, dq / dd, gap, cross(omega, q - centre)});
     }
     for (int j = 0; j < m; ++j) {
@@ -101,9 +128,12 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       if (cross(cur - prev, next - cur) <= 0.0) continue;  // concave or straight
       const Vec2 v = pts[j];
       const Vec2 dq = c - v;
-      const double dd = norm(dq);
+      const double dd2 = norm2(dq);
+      const double lim = r + reach;
+      if (dd2 > lim * lim || dd2 <= 0.0) continue;
+      const double dd = std::sqrt(dd2);
       const double gap = dd - r;
-      if (gap > reach || dd <= 0.0) continue;
+      if (gap > reach) continue;
       hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, dq / dd, gap, cross(omega, v - centre)});
     }
   }
@@ -114,8 +144,23 @@ void Wall::prepare() {
   if (kind != Kind::cylinder || !rough() || !(radius > 0.0)) return;
   for (const auto& v : profile) unit_offsets_.push_back({std::cos(v.x / radius), std::sin(v.x / radius)});
   period_rotation_ = {std::cos(period() / radius), std::sin(period() / radius)};
+  period_units_.resize(static_cast<std::size_t>(std::max(n_periods, 0)));
+  for (int k = 0; k < n_periods; ++k) {
+    const double base = (k * period() + phase) / radius;
+    period_units_[k] = {std::cos(base), std::sin(base)};
+  }
+  max_depth_ = 0.0;
+  for (const auto& v : profile) max_depth_ = std::max(max_depth_, v.y);
   prepared_radius_ = radius;
   prepared_period_ = period();
+  prepared_phase_ = phase;
+  prepare_angle();
+}
+
+void Wall::prepare_angle() {
+  if (prepared_angle_ == angle) return;
+  angle_rotation_ = {std::cos(angle), std::sin(angle)};
+  prepared_angle_ = angle;
 }
 
 double Wall::surface_radius(Vec2 p) const {

@@ -7,6 +7,7 @@
 // feature as the roller turns.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -70,9 +71,16 @@ struct Wall {
   // of one per profile vertex). Called by set_pyramid_roughness and the engine; query() falls
   // back to direct trigonometry when the cache is missing or stale (radius or period changed).
   void prepare();
+  // Caches (cos, sin) of the current angle for query(); the engine calls it (serially) before
+  // each force evaluation. A query at another angle falls back to direct trigonometry.
+  void prepare_angle();
   std::vector<Vec2> unit_offsets_;  // (cos, sin) of s_j / radius for each profile vertex
   Vec2 period_rotation_{1.0, 0.0};  // (cos, sin) of period / radius
-  double prepared_radius_ = 0.0, prepared_period_ = 0.0;
+  std::vector<Vec2> period_units_;  // (cos, sin) of (k P + phase) / radius, roller frame, per period
+  double prepared_radius_ = 0.0, prepared_period_ = 0.0, prepared_phase_ = 0.0;
+  double max_depth_ = 0.0;          // deepest profile vertex [m]
+  Vec2 angle_rotation_{1.0, 0.0};   // (cos, sin) of angle at the last prepare_angle()
+  double prepared_angle_ = std::numeric_limits<double>::quiet_NaN();
   // Advances the prescribed motion by dt.
   void advance(double dt) { angle += omega * dt; }
   // Distance from the axis of the cylinder's surface in the direction of p (radius minus the
