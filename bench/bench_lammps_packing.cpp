@@ -4,9 +4,15 @@
 // Same law, same parameters, same packing as bench_lammps_hooke.in, so disc-steps/s can be
 // compared with LAMMPS's "Loop time" run right before or after (bench/run_lammps_compare.sh).
 //
-// Usage: bench_lammps_packing [--data FILE(.gz)] [--steps N] [--warmup N] [--threads T] [--quiet]
+// Usage: bench_lammps_packing [--data FILE(.gz)] [--steps N] [--warmup N] [--threads T]
+//                             [--tilt-deg A] [--inertia disc|sphere] [--every N]
 // Prints parameters, git hash, throughput of the timed phase and, after it (untimed), the
 // final kinetic energy and contacts per disc for the physics cross-check with LAMMPS.
+// --tilt-deg tilts the body force by A degrees towards +x (the bed slides: the driven variant
+// of bench_lammps_hooke.in's `tilt`); --inertia sphere gives each disc 2/5 m r^2 (LAMMPS
+// fix nve/sphere without `disc`); --every N prints "THERMO step ke_translational_J mean_vx"
+// every N steps from step 0 (warm-up included, as LAMMPS thermo; bench/lammps_thermo.in is the
+// LAMMPS side), so the cross-check is one command each.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +24,7 @@
 
 #include <sys/resource.h>
 
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/version.hpp"
 
@@ -134,15 +141,19 @@ double cpu_seconds() {
 void usage() {
   std::fprintf(stderr,
                "usage: bench_lammps_packing [--data FILE(.gz)] [--steps N=20000] [--warmup N=1000] "
-               "[--threads T=1]\n");
+               "[--threads T=1] [--tilt-deg A=0] [--inertia disc|sphere] [--every N=0]\n");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  nipdem::apply_wait_policy(argv);  // may re-execute once (core/wait_policy.hpp)
   std::string data = "/work/shared/bench/lammps-2d-packing/packing.data.gz";
   long steps = 20000, warmup = 1000;
   int threads = 1;
+  double tilt_deg = 0.0;
+  bool sphere_inertia = false;
+  long every = 0;
   for (int a = 1; a < argc; ++a) {
     const std::string k = argv[a];
     auto val = [&]() -> std::string {
@@ -153,9 +164,15 @@ int main(int argc, char** argv) {
     else if (k == "--steps") steps = std::stol(val());
     else if (k == "--warmup") warmup = std::stol(val());
     else if (k == "--threads") threads = std::stoi(val());
-    else { usage(); return 2; }
+    else if (k == "--tilt-deg") tilt_deg = std::stod(val());
+    else if (k == "--every") every = std::stol(val());
+    else if (k == "--inertia") {
+      const std::string v = val();
+      if (v != "disc" && v != "sphere") { usage(); return 2; }
+      sphere_inertia = v == "sphere";
+    } else { usage(); return 2; }
   }
-  if (steps < 1 || warmup < 0 || threads < 1) { usage(); return 2; }
+  if (steps < 1 || warmup < 0 || threads < 1 || every < 0 || !(std::fabs(tilt_deg) <= 90.0)) { usage(); return 2; }
 
   Packing pk;
   try {
@@ -168,7 +185,8 @@ int main(int argc, char** argv) {
   engine::EngineParams ep;
   ep.integrator = engine::Integrator::velocity_verlet;  // LAMMPS fix nve/sphere
   ep.dt = kDt;
-  ep.gravity = {0.0, -kG};
+  const double tilt = tilt_deg * 3.14159265358979323846 / 180.0;
+  ep.gravity = {kG * std::sin(tilt), -kG * std::cos(tilt)};
   models::ContactParams cp;
   cp.k = kKn;
   cp.ks = kKt;
@@ -192,7 +210,7 @@ int main(int argc, char** argv) {
     s.offsets = {{0.0, 0.0}};
     s.radii = {0.5 * d.d};
     s.density = d.rho;           // mass of a sphere of that diameter (as LAMMPS read_data)
-    s.sphere_inertia = false;    // disc inertia m r^2 / 2 (fix nve/sphere disc)
+    s.sphere_inertia = sphere_inertia;  // default disc inertia m r^2 / 2 (fix nve/sphere disc)
     s.position = {d.x, d.y};
     s.velocity = {d.vx, d.vy};
     s.omega = d.w;
@@ -200,19 +218,32 @@ int main(int argc, char** argv) {
   }
   const std::size_t n = sim.discs().x.size();
 
-  std::printf("bench_lammps_packing git=%s\n", kGitHash);
+  std::printf("bench_lammps_packing git=%s waits=%s\n", kGitHash, nipdem::wait_policy().c_str());
   std::printf("  data=%s discs=%zu box x=[%g,%g] periodic, walls y=%g and y=%g\n", data.c_str(), n, pk.xlo, pk.xhi,
               pk.ylo, pk.yhi);
   std::printf("  kn=%g N/m kt=%g N/m gamma_n=%g 1/s*m_eff gamma_t=%g 1/s*m_eff mu=%g dt=%g s g=%g m/s^2 skin=%g m\n",
               kKn, kKt, kGn, kGt, kMu, kDt, kG, kSkin);
-  std::printf("  threads=%d warmup=%ld steps=%ld\n", threads, warmup, steps);
+  std::printf("  threads=%d warmup=%ld steps=%ld tilt_deg=%g inertia=%s every=%ld\n", threads, warmup, steps, tilt_deg,
+              sphere_inertia ? "sphere" : "disc", every);
   std::fflush(stdout);
 
-  for (long s = 0; s < warmup; ++s) sim.step();
+  // Translational kinetic energy and mean x-velocity (LAMMPS thermo `ke`, reduce ave vx).
+  auto thermo = [&](long step) {
+    if (every <= 0 || step % every != 0) return;
+    const auto& b = sim.bodies();
+    double ke = 0.0, vx = 0.0;
+    for (std::size_t i = 0; i < b.x.size(); ++i) {
+      ke += 0.5 * b.mass[i] * (b.vx[i] * b.vx[i] + b.vy[i] * b.vy[i]);
+      vx += b.vx[i];
+    }
+    std::printf("THERMO %ld %.9g %.9g\n", step, ke, vx / static_cast<double>(b.x.size()));
+  };
+  thermo(0);
+  for (long s = 0; s < warmup; ++s) { sim.step(); thermo(s + 1); }
   const int builds0 = sim.neighbor_list().builds();
   const double c0 = cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
-  for (long s = 0; s < steps; ++s) sim.step();
+  for (long s = 0; s < steps; ++s) { sim.step(); thermo(warmup + s + 1); }
   const auto t1 = std::chrono::steady_clock::now();
   const double cpu = cpu_seconds() - c0;
   const double wall = std::chrono::duration<double>(t1 - t0).count();

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/solvers/ldc/ldc_solver.hpp"
 #include "nipdem/version.hpp"
@@ -151,6 +152,7 @@ const char* kColumns = "analytic/schwarz/fd  unconverged  fd clusters/kept/LU pe
 }  // namespace
 
 int main(int argc, char** argv) {
+  nipdem::apply_wait_policy(argv);  // may re-execute once (core/wait_policy.hpp)
   if (argc == 6 && std::strcmp(argv[1], "--case") == 0) kL = std::atof(argv[5]);  // --case ... BOX_M
   if (argc >= 5 && std::strcmp(argv[1], "--case") == 0) {  // --case DISCS CELLS RESOLVES [BOX_M]
     std::setvbuf(stdout, nullptr, _IOLBF, 0);

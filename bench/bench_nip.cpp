@@ -28,6 +28,7 @@
 #include <sys/resource.h>
 
 #include "bench_args.hpp"
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip.hpp"
 #include "nipdem/experiments/nip_config.hpp"
@@ -401,6 +402,7 @@ double load_average() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  nipdem::apply_wait_policy(argv);  // may re-execute once (core/wait_policy.hpp)
   long steps = 2000, settle = -1;
   int threads = 1, repeat = 1;
   double press_time = 2e-4;
@@ -439,8 +441,8 @@ int main(int argc, char** argv) {
       "inflow.roller_pits=\"empty\"",
   };
   base.insert(base.end(), extra.begin(), extra.end());
-  std::printf("bench_nip git=%s preset=black state=%s steps=%ld settle=%ld threads=%d repeat=%d load_average=%.2f\n", kGitHash,
-              state.c_str(), steps, settle, threads, repeat, load_average());
+  std::printf("bench_nip git=%s preset=black state=%s steps=%ld settle=%ld threads=%d repeat=%d load_average=%.2f waits=%s\n",
+              kGitHash, state.c_str(), steps, settle, threads, repeat, load_average(), nipdem::wait_policy().c_str());
   try {
     State dense;
     if (state == "dense") {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bench_args.hpp"
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip.hpp"
 #include "nipdem/experiments/presets.hpp"
@@ -75,6 +76,7 @@ void print(const char* label, const Result& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  nipdem::apply_wait_policy(argv);  // may re-execute once (core/wait_policy.hpp)
   long steps = 2000, settle = 20000;
   int threads = 1, repeat = 3;
   double x0 = -250e-6, x1 = 450e-6;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/version.hpp"
 #include "registry.hpp"
@@ -63,6 +64,7 @@ void finish_report(const nlohmann::json& j, const std::filesystem::path& out, co
 }  // namespace nipdem::cli
 
 int main(int argc, char** argv) {
+  nipdem::apply_wait_policy(argv);  // may re-execute once (core/wait_policy.hpp)
   CLI::App app{"nipdem: discrete element simulation of toner in the development nip of a DI printer"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("nipdem ") + nipdem::kVersion + " (" + nipdem::kGitHash + ")");

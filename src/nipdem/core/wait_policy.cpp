@@ -1,0 +1,24 @@
+#include "nipdem/core/wait_policy.hpp"
+
+#include <cstdlib>
+
+#include <unistd.h>
+
+namespace nipdem {
+
+void apply_wait_policy(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  if (setenv("GOMP_SPINCOUNT", kSpinCount, 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  unsetenv("GOMP_SPINCOUNT");  // exec failed: go on with libgomp's default
+}
+
+std::string wait_policy() {
+  std::string s;
+  for (const char* k : {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT"}) {
+    if (const char* v = std::getenv(k)) s += (s.empty() ? "" : " ") + std::string(k) + "=" + v;
+  }
+  return s.empty() ? "libgomp default" : s;
+}
+
+}  // namespace nipdem
