@@ -222,6 +222,47 @@ void Simulation::ensure_neighbor_list(int moved) {
   }
   structure_changed_ = false;
   for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
+  build_wall_candidates();
+}
+
+// Which walls each disc may touch until the next list build: may_touch() with the reach
+// widened by the skin, the most any disc moves between builds (the rebuild criterion keeps
+// the sum of the two largest displacements below it). A wall's may_touch() depends only on
+// its fixed shape (plane position, cylinder axis and radius; not on its rotation), so the
+// masks stay valid while the shapes do; a changed shape rebuilds them (wall_shapes_changed).
+void Simulation::build_wall_candidates() {
+  const std::size_t n = d_.x.size(), nw = walls_.size();
+  wall_mask_.assign(n, 0);
+  wall_shape_.resize(nw);
+  for (std::size_t w = 0; w < nw; ++w) wall_shape_[w] = shape_of(w);
+  if (nw == 0) return;
+  if (nw > 32) {  // more walls than mask bits: every disc checks every wall (as before)
+    std::fill(wall_mask_.begin(), wall_mask_.end(), ~std::uint32_t{0});
+    return;
+  }
+  prepare_walls();
+  const double skin = params_.skin;
+#pragma omp parallel for schedule(static) num_threads(params_.threads)
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t m = 0;
+    for (std::size_t w = 0; w < nw; ++w)
+      if (walls_[w].may_touch({d_.x[i], d_.y[i]}, d_.r[i], wall_reach_[w] + skin)) m |= std::uint32_t{1} << w;
+    wall_mask_[i] = m;
+  }
+}
+
+Simulation::WallShape Simulation::shape_of(std::size_t k) const {
+  const geometry::Wall& w = walls_[k];
+  const auto& ad = params_.interactions[w.interaction].adhesion;
+  return {w.kind == geometry::Wall::Kind::plane ? 0 : 1, w.point.x, w.point.y, w.normal.x, w.normal.y,
+          w.centre.x, w.centre.y, w.radius, w.inside ? 1 : 0, ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0, params_.skin};
+}
+
+bool Simulation::wall_shapes_changed() const {
+  if (wall_shape_.size() != walls_.size() || wall_mask_.size() != d_.x.size()) return true;
+  for (std::size_t w = 0; w < walls_.size(); ++w)
+    if (!(shape_of(w) == wall_shape_[w])) return true;
+  return false;
 }
 
 // Row ranges per thread, balanced by list entries, and the highest disc index each range
@@ -287,7 +328,9 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
       const double d2 = dx * dx + dy * dy;
       const double rc = rsum + reach;
       if (d2 >= rc * rc) {
-        eta[e] = 0.0; sl[e] = 0;
+        // Reset history only where there is some: most listed pairs are apart and stay so,
+        // and a read keeps their cache lines clean (no write-back).
+        if (sl[e] != 0 || eta[e] != 0.0) { eta[e] = 0.0; sl[e] = 0; }
         continue;
       }
       const double dist = std::sqrt(d2);
@@ -313,7 +356,7 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
         fny = fn * ny + ft * nx;
         ti = -li * ft;
         tj = -lj * ft;
-      } else {
+      } else if (sl[e] != 0 || eta[e] != 0.0) {
         eta[e] = 0.0; sl[e] = 0;
       }
       if constexpr (kAdhesion) {
@@ -338,7 +381,10 @@ void Simulation::contact_forces() {
   const int n = static_cast<int>(d_.x.size());
   const int nb = static_cast<int>(b_.x.size());
   const bool has_walls = !walls_.empty();
-  if (has_walls) prepare_walls();
+  if (has_walls) {
+    if (wall_shapes_changed()) build_wall_candidates();
+    prepare_walls();
+  }
   const int nt = params_.threads;
   const bool adh = params_.interactions[0].adhesion.hamaker_J != 0.0;
   const bool periodic = params_.periodic_x;
@@ -423,12 +469,15 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
   std::int64_t new_key[kWallSlots];
   double new_eta[kWallSlots];
   std::uint8_t new_sl[kWallSlots];
+  const std::uint32_t mask = wall_mask_[i];
+  if (mask == 0 && d_.wall_key[i * kWallSlots] == -1) return;  // no candidate wall, no history to clear
   const Vec2 c{d_.x[i], d_.y[i]};
   const double r = d_.r[i];
   int nnew = 0;
   double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
   bool touched = false;
   for (std::size_t w = 0; w < nw; ++w) {
+    if (!(mask >> (w & 31) & 1u)) continue;  // (nw > 32: every bit set)
     const auto& wall = walls_[w];
     if (!wall.may_touch(c, r, wall_reach_[w])) continue;  // most discs: no trigonometry, no query
     const Interaction& ia = params_.interactions[wall.interaction];

@@ -138,6 +138,13 @@ class Simulation {
   void reduce_body(std::size_t b);
   void provider_forces();
   void update_thread_split();
+  void build_wall_candidates();
+  struct WallShape {
+    int kind; double px, py, nx, ny, cx, cy, radius; int inside; double reach, skin;
+    bool operator==(const WallShape&) const = default;
+  };
+  WallShape shape_of(std::size_t wall) const;  // what the candidate masks depend on
+  bool wall_shapes_changed() const;
 
   // Hot-loop copies of the per-disc data the pair kernel reads, packed so that one neighbour
   // costs two cache lines to read and one to write instead of ~12 scattered SoA loads
@@ -171,6 +178,8 @@ class Simulation {
   int split_builds_ = -1, split_threads_ = 0;
   std::vector<std::vector<geometry::WallHit>> thread_hits_;  // per-thread wall query scratch
   std::vector<double> wall_reach_;                          // adhesion reach of each wall [m]
+  std::vector<std::uint32_t> wall_mask_;                    // per disc: walls it may touch until the next list build
+  std::vector<WallShape> wall_shape_;                       // wall shapes the masks were built for
   double time_ = 0.0;
   std::int64_t step_ = 0;
   std::int64_t next_id_ = 0;
