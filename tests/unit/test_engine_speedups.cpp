@@ -154,3 +154,34 @@ TEST(NeighborList, TwoLargestDisplacementCriterionNeverMissesAPair) {
   }
   EXPECT_GT(rebuilds, 3);  // the walk does trigger rebuilds
 }
+
+// Walls each disc may touch are listed at each neighbour-list build. A wall that changes shape
+// between builds (an experiment moving a plane) must still be felt at once: the lists are
+// rebuilt when any wall's shape differs from the one they were made for.
+TEST(WallCandidates, AWallMovedBetweenListBuildsIsFeltAtOnce) {
+  EngineParams p;
+  Interaction ia;
+  ia.contact.k = 56;
+  p.interactions = {ia, ia};
+  p.dt = 1e-9;
+  p.skin = 1e-6;
+  geometry::Wall floor;
+  floor.kind = geometry::Wall::Kind::plane;
+  floor.name = "floor";
+  floor.point = {0, 0};
+  floor.normal = {0, 1};
+  floor.interaction = 1;
+  Simulation sim(p, {floor});
+  BodySpec s;
+  s.offsets = {{0, 0}};
+  s.radii = {2e-6};
+  s.density = 1700;
+  s.position = {0, 10e-6};  // 8 um above the floor: no candidate
+  sim.add_body(s);
+  sim.step();
+  EXPECT_EQ(sim.contacts(), 0);
+  sim.walls()[0].point = {0, 9e-6};  // the floor moves up into the disc (1 um overlap)
+  sim.compute_forces();
+  EXPECT_EQ(sim.contacts(), 1);
+  EXPECT_NEAR(sim.bodies().fy[0], 56 * 1e-6, 1e-3 * 56e-6);  // k * overlap, disc at rest
+}

@@ -8,8 +8,14 @@ namespace nipdem {
 
 void apply_wait_policy(char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  // The binary's own path (not /proc/self/exe itself, which would rename the process "exe" in
+  // ps and top).
+  char path[4096];
+  const ssize_t len = readlink("/proc/self/exe", path, sizeof path - 1);
+  if (len <= 0 || len >= static_cast<ssize_t>(sizeof path - 1)) return;
+  path[len] = '\0';
   if (setenv("GOMP_SPINCOUNT", kSpinCount, 1) != 0) return;
-  execv("/proc/self/exe", argv);
+  execv(path, argv);
   unsetenv("GOMP_SPINCOUNT");  // exec failed: go on with libgomp's default
 }
 
