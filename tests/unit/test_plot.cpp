@@ -5,6 +5,7 @@
 #include <cairo.h>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -378,4 +379,34 @@ TEST(Pictures, CoveragePlotsMarkTheIntendedLine) {
   EXPECT_GT(count_colour(dir / "coverage.png", 0.85, 0.33, 0.10, &w, &h), 30);  // the dashed intended line
   EXPECT_EQ(w, 900);
   fs::remove_all(dir);
+}
+
+TEST(Pictures, RenderWritesFramesAndAMovieForAnyFolderName) {
+  // `render --movie` starts ffmpeg without a shell: a folder name with spaces, a quote and a $
+  // reaches it unchanged. Needs ffmpeg (scripts/install-deps); skipped without it.
+  const fs::path base = fresh_dir("movie");
+  const fs::path run = base / "run a'b $HOME";
+  auto quote = [](const std::string& s) {
+    std::string q = "'";
+    for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+  };
+  const std::string ex = std::string(NIPDEM_SOURCE_DIR) + "/examples/nip_black_small.toml";
+  const std::string cli = NIPDEM_CLI_PATH;
+  ASSERT_EQ(std::system((cli + " run " + ex + " --out " + quote(run.string()) +
+                         " --quiet --set run.end_time_s=4e-5 --set run.output_interval_s=2e-5 --set geometry.window_x_min_m=-1e-4"
+                         " --set geometry.window_x_max_m=1e-4 2>/dev/null").c_str()),
+            0);
+  const bool have_ffmpeg = std::system("command -v ffmpeg >/dev/null 2>&1") == 0;
+  const int rc = std::system((cli + " render " + quote(run.string()) + (have_ffmpeg ? " --movie" : "") + " 2>/dev/null").c_str());
+  EXPECT_EQ(rc, 0);
+  EXPECT_TRUE(fs::exists(run / "frames" / "frame_000000.png"));
+  EXPECT_TRUE(fs::exists(run / "frames" / "frame_000002.png"));
+  if (have_ffmpeg) {
+    EXPECT_TRUE(fs::exists(run / "frames" / "movie.mp4"));
+    EXPECT_GT(fs::file_size(run / "frames" / "movie.mp4"), 1000u);
+  } else {
+    GTEST_SKIP() << "ffmpeg not installed: movie not checked";
+  }
+  fs::remove_all(base);
 }
