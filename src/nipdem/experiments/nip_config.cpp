@@ -40,9 +40,9 @@ double derived(io::Section& s, const std::string& key, double lo, double hi, dou
   s.record(key, value);
   return value;
 }
-}  // namespace
 
-namespace {
+// The preset named by the file's (or an override's) `preset` key, with the file and the
+// overrides merged over it key by key.
 toml::table resolve(const std::string& text, const std::string& file, const std::vector<std::string>& overrides, toml::table& user) {
   user = io::parse_toml(text, file);
   for (const auto& o : overrides) io::apply_override(user, o, file);
