@@ -1,6 +1,7 @@
 // `nipdem plot DATA.csv --x COL --y COL[,COL...] --out FILE.png`: quick PNG of CSV columns
 // (front position vs gap, coverage curves, reduction counts vs r ...). Column names are the
-// CSV header names (with their unit suffix); axis labels default to them.
+// CSV header names (with their unit suffix); axis labels and legend entries default to them in
+// words with the unit (io::column_words: "front_std_m" with --yscale 1e6 -> "front std [µm]").
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -15,7 +16,7 @@ namespace {
 
 struct Opts {
   std::string data, x, out, title, xlabel, ylabel;
-  std::vector<std::string> y, yerr;
+  std::vector<std::string> y, yerr, labels;
   bool logx = false, logy = false, markers = false, no_lines = false, json = false;
   int width = 800, height = 560;
   double xscale = 1.0, yscale = 1.0;
@@ -30,8 +31,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--yerr", o->yerr, "error-bar column(s), one per --y column")->delimiter(',');
   sub->add_option("--out", o->out, "output PNG")->required();
   sub->add_option("--title", o->title, "plot title");
-  sub->add_option("--xlabel", o->xlabel, "x axis label with unit (default: the column name)");
-  sub->add_option("--ylabel", o->ylabel, "y axis label with unit (default: the first y column)");
+  sub->add_option("--labels", o->labels, "legend entries, one per --y column, comma separated (default: the columns in words)")->delimiter(',');
+  sub->add_option("--xlabel", o->xlabel, "x axis label with unit (default: the column in words with its unit)");
+  sub->add_option("--ylabel", o->ylabel, "y axis label with unit (default: the first y column in words)");
   sub->add_option("--xscale", o->xscale, "multiply x values (e.g. 1e6 to show metres as µm)")->capture_default_str();
   sub->add_option("--yscale", o->yscale, "multiply y values and error bars")->capture_default_str();
   sub->add_flag("--logx", o->logx, "logarithmic x axis");
@@ -48,8 +50,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
                           "needs one error column per --y column", std::to_string(o->y.size()));
     nipdem::io::PlotSpec p;
     p.title = o->title;
-    p.x_label = o->xlabel.empty() ? o->x : o->xlabel;
-    p.y_label = o->ylabel.empty() ? o->y.front() : o->ylabel;
+    if (!o->labels.empty() && o->labels.size() != o->y.size())
+      nipdem::throw_input("plot", "--labels", std::to_string(o->labels.size()) + " entries", "needs one legend entry per --y column",
+                          std::to_string(o->y.size()));
+    p.x_label = o->xlabel.empty() ? nipdem::io::column_words(o->x, o->xscale) : o->xlabel;
+    p.y_label = o->ylabel.empty() ? nipdem::io::column_words(o->y.front(), o->yscale) : o->ylabel;
     p.log_x = o->logx;
     p.log_y = o->logy;
     p.width = o->width;
@@ -58,7 +63,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
     for (double& v : x) v *= o->xscale;
     for (std::size_t k = 0; k < o->y.size(); ++k) {
       nipdem::io::Series s;
-      s.label = o->y.size() > 1 || !o->yerr.empty() ? o->y[k] : "";
+      s.label = !o->labels.empty() ? o->labels[k]
+                : o->y.size() > 1 || !o->yerr.empty() ? nipdem::io::column_words(o->y[k], o->yscale) : "";
       s.x = x;
       s.y = t.column(o->y[k]);
       for (double& v : s.y) v *= o->yscale;

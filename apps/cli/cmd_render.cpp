@@ -1,4 +1,4 @@
-// `nipdem render RUN_DIR [--color-by speed|force] [--width PX]`
+// `nipdem render RUN_DIR [--color-by speed|force] [--width PX] [--color-max V] [--movie]`
 #include <cstdio>
 
 #include "nipdem/io/render.hpp"
@@ -16,18 +16,14 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("run_dir", o->dir, "output folder of `nipdem run`")->required();
   sub->add_option("--color-by", o->ro.color_by, "speed or force")->capture_default_str();
   sub->add_option("--width", o->ro.width_px, "image width [px]")->capture_default_str()->check(CLI::Range(200, 8000));
-  sub->add_option("--color-max", o->ro.color_max, "value mapped to the top of the colour bar (0 = auto)");
+  sub->add_option("--color-max", o->ro.color_max, "value mapped to the top of the colour bar [m/s or N] (0 = median over the frames of each frame's 98th percentile)");
   sub->add_flag("--movie", o->movie, "also assemble frames/movie.mp4 (needs ffmpeg on PATH)");
   sub->callback([o] {
     const int n = nipdem::io::render_run(o->dir, o->ro);
     std::fprintf(stderr, "nipdem render: %d frames in %s/frames/\n", n, o->dir.c_str());
     if (o->movie) {
-      if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
-        throw std::runtime_error("--movie needs ffmpeg (apt-get install ffmpeg); the PNG frames were written");
-      const std::string cmd = "ffmpeg -y -loglevel error -framerate 10 -i '" + o->dir + "/frames/frame_%06d.png' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -pix_fmt yuv420p '" +
-                              o->dir + "/frames/movie.mp4.tmp.mp4' && mv '" + o->dir + "/frames/movie.mp4.tmp.mp4' '" + o->dir + "/frames/movie.mp4'";
-      if (std::system(cmd.c_str()) != 0) throw std::runtime_error("ffmpeg failed to assemble the movie");
-      std::fprintf(stderr, "nipdem render: %s/frames/movie.mp4\n", o->dir.c_str());
+      const auto movie = nipdem::io::write_movie(o->dir);
+      std::fprintf(stderr, "nipdem render: %s\n", movie.string().c_str());
     }
   });
 });

@@ -5,8 +5,11 @@
 #include <cairo.h>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+
+#include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/analysis_fit.hpp"
@@ -14,6 +17,8 @@
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"
+#include "nipdem/io/render.hpp"
+#include "nipdem/experiments/analysis_report.hpp"
 
 using namespace nipdem;
 namespace fs = std::filesystem;
@@ -289,4 +294,119 @@ TEST(AnalysisCsv, CliPlotExitsTwoOnBadCsv) {
                        .c_str());
   EXPECT_EQ(WEXITSTATUS(st), 2);
   fs::remove_all(dir);
+}
+
+TEST(Pictures, ViridisEndsAndIsMonotoneInLightness) {
+  // The map's published end colours (#440154, #fde725) and a brightness that rises throughout
+  // (perceptually ordered, readable in grey).
+  const auto a = io::viridis(0.0), b = io::viridis(1.0);
+  EXPECT_NEAR(a[0], 68 / 255.0, 1e-12);
+  EXPECT_NEAR(a[2], 84 / 255.0, 1e-12);
+  EXPECT_NEAR(b[0], 253 / 255.0, 1e-12);
+  EXPECT_NEAR(b[1], 231 / 255.0, 1e-12);
+  double last = -1;
+  for (int i = 0; i <= 100; ++i) {
+    const auto c = io::viridis(i / 100.0);
+    const double luma = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    EXPECT_GT(luma, last) << i;
+    last = luma;
+  }
+  EXPECT_EQ(io::viridis(2.0), b);   // clamped for display
+  EXPECT_EQ(io::viridis(NAN), a);
+}
+
+TEST(Pictures, PercentileColourRangeIgnoresAFewFastStrays) {
+  std::vector<double> v(1000);
+  for (int i = 0; i < 1000; ++i) v[i] = 0.1 + 0.4 * i / 999.0;  // 0.1 ... 0.5 m/s
+  const double clean = io::percentile(v, 0.95);
+  for (int i = 0; i < 10; ++i) v.push_back(50.0);  // ten strays, 100x faster
+  const double with_strays = io::percentile(v, 0.95);
+  EXPECT_NEAR(clean, 0.48, 0.01);
+  EXPECT_LT(with_strays / clean, 1.02);
+  EXPECT_EQ(io::percentile({}, 0.95), 0.0);
+  EXPECT_EQ(io::colour_scale("speed", 0.5).label, "speed [mm/s]");
+  EXPECT_EQ(io::colour_scale("force", 1e-9).label, "|force| per disc [nN]");
+}
+
+TEST(Pictures, LegendsAndAxesInWordsWithUnits) {
+  EXPECT_EQ(io::column_words("front_std_m", 1e6), "front std [µm]");
+  EXPECT_EQ(io::column_words("s_begin_m", 1e6), "s begin [µm]");
+  EXPECT_EQ(io::column_words("coverage"), "coverage");
+  EXPECT_EQ(io::column_words("time_s", 1e3), "time [ms]");
+  EXPECT_EQ(io::column_words("force_N", 1e9), "force [nN]");
+  EXPECT_EQ(io::column_words("sleeve_speed_m_per_s"), "sleeve speed [m/s]");
+  EXPECT_EQ(io::column_words("removed_per_100ms"), "removed per 100ms");
+}
+
+TEST(Pictures, NoLineWhereTheDataDoNotResolveATrend) {
+  io::Series s;
+  s.x = {100, 150, 200};
+  s.y = {-80, -70, -84};
+  s.y_err = {15, 20, 12};  // every step within the spread
+  s.line_only_if_resolved = true;
+  EXPECT_FALSE(io::draws_line(s));
+  s.y = {-80, -140, -200};  // steps of 60 um against spreads of ~25 um
+  EXPECT_TRUE(io::draws_line(s));
+  s.line = false;
+  EXPECT_FALSE(io::draws_line(s));
+  io::Series plain;
+  plain.x = {1, 2};
+  plain.y = {1, 1};
+  EXPECT_TRUE(io::draws_line(plain));  // the default is unchanged
+}
+
+TEST(Pictures, CoveragePlotsMarkTheIntendedLine) {
+  // Edge-sharpness's average-coverage plot: the line the track printed is drawn as a dashed box.
+  std::vector<double> x = {0.0, 1e-4, 2e-4, 3e-4}, c = {0, 0.5, 1, 0};
+  analysis::LineEdgesFit fit{};
+  const auto p = analysis::coverage_plot(x, c, fit, "t", 1e-4, 2.5e-4);
+  ASSERT_EQ(p.series.size(), 3u);
+  EXPECT_EQ(p.series[2].label, "intended line (track voltage on)");
+  EXPECT_EQ(p.series[2].x, (std::vector<double>{100, 100, 250, 250}));
+  EXPECT_FALSE(io::draws_line(p.series[0]));  // the bins are markers
+  EXPECT_NE(p.x_label.find("[µm]"), std::string::npos);
+  // A single run's coverage.csv: bins, and the intended line from the track voltage column.
+  const fs::path dir = fresh_dir("coverage_run");
+  std::string csv = "s_begin_m,s_end_m,coverage,particles,track_voltage_V\n";
+  for (int i = 0; i < 40; ++i) {
+    const double s0 = i * 2.5e-6;
+    const bool on = s0 >= 25e-6 && s0 < 60e-6;
+    csv += fmt::format("{},{},{},{},{}\n", s0, s0 + 2.5e-6, on && i % 3 ? 1 : 0, on ? 1 : 0, on ? 40 : 0);
+  }
+  io::write_file_atomic(dir / "coverage.csv", csv);
+  io::write_coverage_png(dir / "coverage.csv", dir / "coverage.png");
+  int w = 0, h = 0;
+  EXPECT_GT(count_colour(dir / "coverage.png", 0.85, 0.33, 0.10, &w, &h), 30);  // the dashed intended line
+  EXPECT_EQ(w, 900);
+  fs::remove_all(dir);
+}
+
+TEST(Pictures, RenderWritesFramesAndAMovieForAnyFolderName) {
+  // `render --movie` starts ffmpeg without a shell: a folder name with spaces, a quote and a $
+  // reaches it unchanged. Needs ffmpeg (scripts/install-deps); skipped without it.
+  const fs::path base = fresh_dir("movie");
+  const fs::path run = base / "run a'b $HOME";
+  auto quote = [](const std::string& s) {
+    std::string q = "'";
+    for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+  };
+  const std::string ex = std::string(NIPDEM_SOURCE_DIR) + "/examples/nip_black_small.toml";
+  const std::string cli = NIPDEM_CLI_PATH;
+  ASSERT_EQ(std::system((cli + " run " + ex + " --out " + quote(run.string()) +
+                         " --quiet --set run.end_time_s=4e-5 --set run.output_interval_s=2e-5 --set geometry.window_x_min_m=-1e-4"
+                         " --set geometry.window_x_max_m=1e-4 2>/dev/null").c_str()),
+            0);
+  const bool have_ffmpeg = std::system("command -v ffmpeg >/dev/null 2>&1") == 0;
+  const int rc = std::system((cli + " render " + quote(run.string()) + (have_ffmpeg ? " --movie" : "") + " 2>/dev/null").c_str());
+  EXPECT_EQ(rc, 0);
+  EXPECT_TRUE(fs::exists(run / "frames" / "frame_000000.png"));
+  EXPECT_TRUE(fs::exists(run / "frames" / "frame_000002.png"));
+  if (have_ffmpeg) {
+    EXPECT_TRUE(fs::exists(run / "frames" / "movie.mp4"));
+    EXPECT_GT(fs::file_size(run / "frames" / "movie.mp4"), 1000u);
+  } else {
+    GTEST_SKIP() << "ffmpeg not installed: movie not checked";
+  }
+  fs::remove_all(base);
 }

@@ -76,11 +76,11 @@ void write_coverage_csv(const std::filesystem::path& path, const std::vector<dou
 }
 
 io::PlotSpec coverage_plot(const std::vector<double>& x, const std::vector<double>& c, const LineEdgesFit& fit,
-                           const std::string& title) {
+                           const std::string& title, double line_start_m, double line_end_m) {
   io::PlotSpec p;
   p.title = title;
-  p.x_label = "position x [µm]";
-  p.y_label = "coverage [-]";
+  p.x_label = "drum surface position s [µm]";
+  p.y_label = "coverage (fraction of lines covering the bin) [-]";
   io::Series data, model;
   data.label = "average coverage";
   data.line = false;
@@ -94,6 +94,16 @@ io::PlotSpec coverage_plot(const std::vector<double>& x, const std::vector<doubl
     model.y.push_back(evaluate(fit, x[i]));
   }
   p.series = {data, model};
+  if (line_end_m > line_start_m) {
+    io::Series line;
+    line.label = "intended line (track voltage on)";
+    line.dashed = true;
+    line.color = std::array<double, 3>{0.3, 0.3, 0.3};
+    const double a = 1e6 * line_start_m, b = 1e6 * line_end_m;
+    line.x = {a, a, b, b};
+    line.y = {0.0, 1.0, 1.0, 0.0};
+    p.series.push_back(line);
+  }
   return p;
 }
 

@@ -29,8 +29,11 @@ nlohmann::json to_json(const VoStatistics& v);       // vo_mean_V, vo_std_V, vo_
 // Coverage curve file: columns x_m, coverage, fit (the fitted model at x). Atomic write.
 void write_coverage_csv(const std::filesystem::path& path, const std::vector<double>& x_m,
                         const std::vector<double>& coverage, const LineEdgesFit& fit);
-// Plot of an average coverage curve with its fit (x shown in µm), as in thesis fig. 1.8.
+// Plot of an average coverage curve with its fit (x = drum surface position, shown in µm), as in
+// thesis fig. 1.8, with the intended line [line_start_m, line_end_m] (track voltage on) marked
+// when line_end_m > line_start_m.
 io::PlotSpec coverage_plot(const std::vector<double>& x_m, const std::vector<double>& coverage,
-                           const LineEdgesFit& fit, const std::string& title);
+                           const LineEdgesFit& fit, const std::string& title, double line_start_m = 0.0,
+                           double line_end_m = 0.0);
 
 }  // namespace nipdem::analysis

@@ -10,6 +10,8 @@
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/io/print_pattern.hpp"
+#include "nipdem/experiments/presets.hpp"
+#include <algorithm>
 #include <filesystem>
 
 namespace nipdem::experiments {
@@ -18,68 +20,103 @@ using constants::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 namespace {
-CollisionType read_collision(io::Section s, CollisionType def) {
+// Every key below is required: the preset supplies whatever the user's file omits, so the
+// loader holds no default of its own (data/presets/*.toml is the one source). Only values
+// derived from other keys (the pigment's magnetisation, the charge preset's RC values, the
+// capacitor range = d50) are filled in here, and recorded in the resolved table.
+CollisionType read_collision(io::Section s) {
   CollisionType c;
-  c.restitution = s.number("restitution", 0.01, 1.0, def.restitution);
-  c.k = s.number("k_N_per_m", 1e-6, 1e9, def.k);
-  c.mu_s = s.number("mu_s", 0.0, 10.0, def.mu_s);
-  c.mu_d = s.number("mu_d", 0.0, 10.0, def.mu_d);
+  c.restitution = s.number("restitution", 0.01, 1.0);
+  c.k = s.number("k_N_per_m", 1e-6, 1e9);
+  c.mu_s = s.number("mu_s", 0.0, 10.0);
+  c.mu_d = s.number("mu_d", 0.0, 10.0);
   if (c.mu_d > c.mu_s) throw_input(s.file(), s.key_path("mu_d"), fmt::format("{:g}", c.mu_d), "dynamic friction must not exceed static", fmt::format("[0, mu_s = {:g}]", c.mu_s));
   s.finish();
   return c;
 }
+
+double derived(io::Section& s, const std::string& key, double lo, double hi, double value) {
+  if (s.has(key)) return s.number(key, lo, hi);
+  s.record(key, value);
+  return value;
+}
+
+// The preset named by the file's (or an override's) `preset` key, with the file and the
+// overrides merged over it key by key.
+toml::table resolve(const std::string& text, const std::string& file, const std::vector<std::string>& overrides, toml::table& user) {
+  user = io::parse_toml(text, file);
+  for (const auto& o : overrides) io::apply_override(user, o, file);
+  std::string preset = "black";
+  if (const toml::node* n = user.get("preset")) {
+    const auto names = preset_names();
+    const auto v = n->value<std::string>();
+    if (!v || std::find(names.begin(), names.end(), *v) == names.end())
+      throw_input(file, "preset", v ? "\"" + *v + "\"" : "(not a string)", "unknown preset", "black, color");
+    preset = *v;
+  }
+  toml::table root = io::parse_toml(preset_text(preset), "preset:" + preset);
+  io::merge_into(root, user);
+  return root;
+}
 }  // namespace
 
+toml::table resolve_nip_table(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+  toml::table user;
+  return resolve(text, file, overrides, user);
+}
+
 NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
-  toml::table root = io::parse_toml(text, file);
-  for (const auto& o : overrides) io::apply_override(root, o, file);
+  toml::table user;
+  toml::table root = resolve(text, file, overrides, user);
+  const bool user_print = user.contains("print");
   NipConfig c;
   c.file = file;
   io::Section top(&root, file, "");
+  c.preset = top.choice("preset", preset_names());
 
   {
     auto s = top.sub("run");
-    c.seed = static_cast<std::uint64_t>(s.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
-    c.end_time = s.number("end_time_s", 0.0, 10.0, c.end_time);
-    c.output_interval = s.number("output_interval_s", 1e-9, 10.0, c.output_interval);
-    c.checkpoint_interval = s.number("checkpoint_interval_s", 1e-9, 10.0, c.checkpoint_interval);
-    c.threads = static_cast<int>(s.integer("threads", 1, 256, 1));
-    c.integrator = s.choice("integrator", {"velocity_verlet", "newmark_explicit"}, "velocity_verlet") == "velocity_verlet"
+    c.seed = static_cast<std::uint64_t>(s.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
+    c.end_time = s.number("end_time_s", 0.0, 10.0);
+    c.output_interval = s.number("output_interval_s", 1e-9, 10.0);
+    c.checkpoint_interval = s.number("checkpoint_interval_s", 1e-9, 10.0);
+    c.threads = static_cast<int>(s.integer("threads", 1, 256));
+    c.integrator = s.choice("integrator", {"velocity_verlet", "newmark_explicit"}) == "velocity_verlet"
                        ? engine::Integrator::velocity_verlet : engine::Integrator::newmark_explicit;
-    c.dt = s.number("dt_s", 0.0, 1e-3, 0.0);
-    c.dt_fraction = s.number("dt_fraction_of_contact_time", 1e-4, 0.5, c.dt_fraction);
-    c.list_skin_d50 = s.number("neighbor_skin_d50", 0.01, 2.0, c.list_skin_d50);
+    c.dt = s.number("dt_s", 0.0, 1e-3);
+    c.dt_fraction = s.number("dt_fraction_of_contact_time", 1e-4, 0.5);
+    c.list_skin_d50 = s.number("neighbor_skin_d50", 0.01, 2.0);
     s.finish();
   }
   {
     auto s = top.sub("geometry");
-    c.gap = s.number("gap_m", 1e-6, 5e-3, c.gap);
-    c.drum_radius = s.number("drum_radius_m", 1e-3, 1.0, c.drum_radius);
-    c.roller_radius = s.number("roller_radius_m", 1e-3, 1.0, c.roller_radius);
-    c.drum_speed = s.number("drum_surface_speed_m_per_s", -100.0, 100.0, c.drum_speed);
-    c.roller_speed = s.number("roller_surface_speed_m_per_s", -100.0, 100.0, c.roller_speed);
-    c.nip_x = s.number("nip_x_m", -0.01, 0.01, c.nip_x);
-    c.x_min = s.number("window_x_min_m", -0.01, 0.0, c.x_min);
-    c.x_max = s.number("window_x_max_m", 0.0, 0.01, c.x_max);
+    c.gap = s.number("gap_m", 1e-6, 5e-3);
+    c.drum_radius = s.number("drum_radius_m", 1e-3, 1.0);
+    c.roller_radius = s.number("roller_radius_m", 1e-3, 1.0);
+    c.drum_speed = s.number("drum_surface_speed_m_per_s", -100.0, 100.0);
+    c.roller_speed = s.number("roller_surface_speed_m_per_s", -100.0, 100.0);
+    c.nip_x = s.number("nip_x_m", -0.01, 0.01);
+    c.x_min = s.number("window_x_min_m", -0.01, 0.0);
+    c.x_max = s.number("window_x_max_m", 0.0, 0.01);
     if (c.x_max - c.x_min < 50e-6) throw_input(file, "geometry.window_x_max_m", fmt::format("{:g}", c.x_max), "window narrower than 50 um", "window_x_max_m - window_x_min_m >= 5e-5");
     auto r = s.sub("roughness");
-    c.roughness = r.boolean("enabled", true);
-    c.rough_height = r.number("height_m", 0.0, 1e-3, c.rough_height);
-    c.rough_base = r.number("base_m", 1e-7, 1e-2, c.rough_base);
-    c.rough_spacing = r.number("spacing_m", 0.0, 1e-2, c.rough_spacing);
+    c.roughness = r.boolean("enabled");
+    c.rough_height = r.number("height_m", 0.0, 1e-3);
+    c.rough_base = r.number("base_m", 1e-7, 1e-2);
+    c.rough_spacing = r.number("spacing_m", 0.0, 1e-2);
     r.finish();
     s.finish();
   }
   {
     auto s = top.sub("toner");
-    c.size.d_small = s.number("d_small_m", 1e-7, 1e-3, c.size.d_small);
-    c.size.d50 = s.number("d50_m", 1e-7, 1e-3, c.size.d50);
-    c.size.d_large = s.number("d_large_m", 1e-7, 1e-3, c.size.d_large);
-    c.size.number_weighted = s.choice("size_weighting", {"number", "volume"}, "number") == "number";
+    c.size.d_small = s.number("d_small_m", 1e-7, 1e-3);
+    c.size.d50 = s.number("d50_m", 1e-7, 1e-3);
+    c.size.d_large = s.number("d_large_m", 1e-7, 1e-3);
+    c.size.number_weighted = s.choice("size_weighting", {"number", "volume"}) == "number";
     c.size.validate(file);
-    c.density = s.number("density_kg_per_m3", 1.0, 1e5, c.density);
-    c.cluster = s.string("cluster", c.cluster);
-    c.cluster_file = s.string("cluster_file", "");
+    c.density = s.number("density_kg_per_m3", 1.0, 1e5);
+    c.cluster = s.string("cluster");
+    c.cluster_file = s.string("cluster_file");
     s.finish();
   }
   if (c.cluster_file.empty()) {
@@ -90,86 +127,88 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   find_template(c.templates, c.cluster, file, "toner.cluster");
   {
     auto s = top.sub("collision");
-    c.stiffness_scale = s.number("stiffness_scale", 1e-6, 1.0, 1.0);
-    c.damping = s.choice("damping_convention", {"physical", "thesis"}, "physical") == "physical"
+    c.stiffness_scale = s.number("stiffness_scale", 1e-6, 1.0);
+    c.damping = s.choice("damping_convention", {"physical", "thesis"}) == "physical"
                     ? models::DampingConvention::physical : models::DampingConvention::thesis;
-    c.tt = read_collision(s.sub("toner_toner"), {0.85, 56, 0.47, 0.19});
-    c.ti = read_collision(s.sub("toner_roller"), {0.58, 117, 0.58, 0.40});
-    c.td = read_collision(s.sub("toner_drum"), {0.95, 126, 0.53, 0.34});
+    c.tt = read_collision(s.sub("toner_toner"));
+    c.ti = read_collision(s.sub("toner_roller"));
+    c.td = read_collision(s.sub("toner_drum"));
     s.finish();
   }
   {
     auto s = top.sub("adhesion");
-    c.adhesion_distance = s.choice("distance", {"surface", "centre"}, "surface") == "surface"
+    c.adhesion_distance = s.choice("distance", {"surface", "centre"}) == "surface"
                               ? models::HamakerParams::Distance::surface : models::HamakerParams::Distance::centre;
-    c.min_separation = s.number("min_separation_m", 1e-11, 1e-6, c.min_separation);
-    c.adhesion_cutoff = s.number("cutoff_m", 0.0, 1e-4, c.adhesion_cutoff);
-    c.adhesion_roller_force = s.number("roller_force_N", 0.0, 1e-3, c.adhesion_roller_force);
-    c.adhesion_drum_force = s.number("drum_force_N", 0.0, 1e-3, c.adhesion_drum_force);
-    c.cohesion_ratio = s.number("cohesion_ratio", 0.0, 1e6, c.cohesion_ratio);
+    c.min_separation = s.number("min_separation_m", 1e-11, 1e-6);
+    c.adhesion_cutoff = s.number("cutoff_m", 0.0, 1e-4);
+    c.adhesion_roller_force = s.number("roller_force_N", 0.0, 1e-3);
+    c.adhesion_drum_force = s.number("drum_force_N", 0.0, 1e-3);
+    c.cohesion_ratio = s.number("cohesion_ratio", 0.0, 1e6);
     s.finish();
   }
   {
     auto s = top.sub("inflow");
-    c.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-3, c.layer_thickness);
-    c.area_fraction = s.number("area_fraction", 0.0, 0.85, c.area_fraction);
-    c.insert_interval = static_cast<int>(s.integer("interval_steps", 1, 1000000, c.insert_interval));
-    c.prefill = s.boolean("prefill", c.prefill);
-    c.roller_pits_filled = s.choice("roller_pits", {"empty", "filled"}, "empty") == "filled";
+    c.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-3);
+    c.area_fraction = s.number("area_fraction", 0.0, 0.85);
+    c.insert_interval = static_cast<int>(s.integer("interval_steps", 1, 1000000));
+    c.prefill = s.boolean("prefill");
+    c.roller_pits_filled = s.choice("roller_pits", {"empty", "filled"}) == "filled";
     s.finish();
   }
   {
     auto s = top.sub("initial_assembly");
     auto& a = c.assembly;
-    a.enabled = s.boolean("enabled", a.enabled);
-    a.x_min = s.number("x_min_m", -0.05, 0.05, a.x_min);
-    a.x_max = s.number("x_max_m", -0.05, 0.05, a.x_max);
-    a.height = s.number("height_m", 0.0, 1e-2, a.height);
-    a.area_fraction = s.number("area_fraction", 0.05, 0.75, a.area_fraction);
+    a.enabled = s.boolean("enabled");
+    a.x_min = s.number("x_min_m", -0.05, 0.05);
+    a.x_max = s.number("x_max_m", -0.05, 0.05);
+    a.height = s.number("height_m", 0.0, 1e-2);
+    a.area_fraction = s.number("area_fraction", 0.05, 0.75);
     s.finish();
   }
   {
     auto s = top.sub("gravity");
-    auto g = s.numbers("vector_m_per_s2", 2, -1e6, 1e6, {c.gravity.x, c.gravity.y});
+    auto g = s.numbers("vector_m_per_s2", 2, -1e6, 1e6);
     c.gravity = {g[0], g[1]};
     s.finish();
   }
   {
     auto s = top.sub("magnet");
-    c.magnet.field = s.choice("field", {"knife", "color_pole", "map", "none"}, c.magnet.field);
-    c.magnet.map_file = s.string("map_file", "");
+    c.magnet.field = s.choice("field", {"knife", "color_pole", "map", "none"});
+    c.magnet.map_file = s.string("map_file");
     if (c.magnet.field == "map" && c.magnet.map_file.empty())
       throw_input(file, "magnet.map_file", "", "field = \"map\" needs a map_file (CSV x_m,y_m,Bx_T,By_T)");
-    const std::string pig = s.choice("pigment", {"black", "color"}, "black");
-    c.magnet.toner = pig == "black" ? magnet::black_toner() : magnet::color_toner();
-    c.magnet.toner.Ms_A_per_m = s.number("saturation_magnetisation_A_per_m", 1e-3, 1e7, c.magnet.toner.Ms_A_per_m);
-    c.magnet.toner.B_sat_T = s.number("saturation_flux_T", 1e-6, 10.0, c.magnet.toner.B_sat_T);
-    c.magnet.toner.eta = s.number("pigment_volume_fraction", 1e-6, 1.0, c.magnet.toner.eta);
-    c.magnet.dipole_dipole = s.boolean("dipole_dipole", c.magnet.dipole_dipole);
-    c.magnet.dipole_cutoff = s.number("dipole_cutoff_m", 1e-7, 1e-3, c.magnet.dipole_cutoff);
-    c.magnet.dipole_skin = s.number("dipole_skin_m", 1e-8, 1e-4, c.magnet.dipole_skin);
-    c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000, c.magnet.dipole_interval));
-    c.magnet.field_interval = static_cast<int>(s.integer("field_interval_steps", 1, 100000, c.magnet.field_interval));
+    const std::string pig = s.choice("pigment", {"black", "color"});
+    const magnet::MagnetisationParams p = pig == "black" ? magnet::black_toner() : magnet::color_toner();
+    c.magnet.toner = p;
+    c.magnet.toner.Ms_A_per_m = derived(s, "saturation_magnetisation_A_per_m", 1e-3, 1e7, p.Ms_A_per_m);
+    c.magnet.toner.B_sat_T = derived(s, "saturation_flux_T", 1e-6, 10.0, p.B_sat_T);
+    c.magnet.toner.eta = derived(s, "pigment_volume_fraction", 1e-6, 1.0, p.eta);
+    c.magnet.dipole_dipole = s.boolean("dipole_dipole");
+    c.magnet.dipole_cutoff = s.number("dipole_cutoff_m", 1e-7, 1e-3);
+    c.magnet.dipole_skin = s.number("dipole_skin_m", 1e-8, 1e-4);
+    c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000));
+    c.magnet.field_interval = static_cast<int>(s.integer("field_interval_steps", 1, 100000));
     s.finish();
     if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
   }
   {
     auto s = top.sub("electric");
     auto& e = c.electric;
-    e.enabled = s.boolean("enabled", false);
-    e.force.model = electric::parse_force_model(s.choice("model", {"exact", "series", "approx"}, "exact"), file, "electric.model");
-    e.force.approx_coefficient = s.number("approx_coefficient", 1e-3, 10.0, e.force.approx_coefficient);
-    e.dielectric_layer = s.boolean("dielectric_layer", true);
-    e.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-4, e.layer_thickness);
-    e.layer_permittivity = s.number("layer_permittivity", 1.0, 1e4, e.layer_permittivity);
-    e.rc = s.choice("charge_preset", {"black", "color"}, "black") == "black" ? charge::RcChargeParams::black() : charge::RcChargeParams::colour();
-    e.rc.R_tt_ohm = s.number("R_tt_ohm", 1.0, 1e30, e.rc.R_tt_ohm);
-    e.rc.R_ti_ohm = s.number("R_ti_ohm", 1.0, 1e30, e.rc.R_ti_ohm);
-    e.rc.C_td_F = s.number("C_td_F", 1e-25, 1e-6, e.rc.C_td_F);
-    e.rc.R_td_ohm = s.number("R_td_ohm", 1.0, 1e40, e.rc.R_td_ohm);
-    e.rc.range_m = s.number("range_m", 1e-8, 1e-3, c.size.d50);
-    e.corridor_fraction = s.number("corridor_fraction", 0.0, 0.999, 0.0);
-    e.path_interval = static_cast<int>(s.integer("path_interval_steps", 1, 1000000, e.path_interval));
+    e.enabled = s.boolean("enabled");
+    e.force.model = electric::parse_force_model(s.choice("model", {"exact", "series", "approx"}), file, "electric.model");
+    e.force.approx_coefficient = s.number("approx_coefficient", 1e-3, 10.0);
+    e.dielectric_layer = s.boolean("dielectric_layer");
+    e.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-4);
+    e.layer_permittivity = s.number("layer_permittivity", 1.0, 1e4);
+    const auto rc = s.choice("charge_preset", {"black", "color"}) == "black" ? charge::RcChargeParams::black() : charge::RcChargeParams::colour();
+    e.rc = rc;
+    e.rc.R_tt_ohm = derived(s, "R_tt_ohm", 1.0, 1e30, rc.R_tt_ohm);
+    e.rc.R_ti_ohm = derived(s, "R_ti_ohm", 1.0, 1e30, rc.R_ti_ohm);
+    e.rc.C_td_F = derived(s, "C_td_F", 1e-25, 1e-6, rc.C_td_F);
+    e.rc.R_td_ohm = derived(s, "R_td_ohm", 1.0, 1e40, rc.R_td_ohm);
+    e.rc.range_m = derived(s, "range_m", 1e-8, 1e-3, c.size.d50);
+    e.corridor_fraction = s.number("corridor_fraction", 0.0, 0.999);
+    e.path_interval = static_cast<int>(s.integer("path_interval_steps", 1, 1000000));
     s.finish();
     e.force.validate();
     e.rc.validate();
@@ -178,16 +217,13 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     e.drum_radius = c.drum_radius;
     toml::table* print = root["print"].as_table();
     top.sub("print");  // its keys are checked by the pattern parser
-    if (print) {
-      e.pattern = io::pattern_from_toml(*print, file, std::filesystem::path(file).parent_path());
-    } else {
-      e.pattern = io::PrintPattern::none();
-    }
-    if (e.enabled && !print) throw_input(file, "print", "", "[electric] enabled = true needs a [print] table (e.g. pattern = \"line\")");
+    if (!print) throw_input(file, "print", "", "must be a table ([print])");
+    e.pattern = io::pattern_from_toml(*print, file, std::filesystem::path(file).parent_path());
+    if (e.enabled && !user_print) throw_input(file, "print", "", "[electric] enabled = true needs a [print] table (e.g. pattern = \"line\")");
   }
   {
     auto s = top.sub("output");
-    c.vtk = s.boolean("vtk", true);
+    c.vtk = s.boolean("vtk");
     s.finish();
   }
   top.finish();
@@ -210,9 +246,25 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
       throw_input(file, "initial_assembly.x_min_m", fmt::format("[{:g}, {:g}]", c.assembly.x_min, c.assembly.x_max), "assembly outside the window",
                   fmt::format("within [{:g}, {:g}]", c.x_min, c.x_max));
   }
-  std::ostringstream ss;
-  ss << root;
-  c.resolved_toml = ss.str();
+  {
+    // config.toml of a run folder must work from there: file names become absolute (a pattern
+    // file is relative to the config's folder, a cluster or map file to the working folder).
+    // The resume key keeps the names as given.
+    toml::table resolved = root;
+    auto absolute = [](toml::table* t, const char* key, const std::filesystem::path& base) {
+      if (!t) return;
+      const auto v = (*t)[key].value<std::string>();
+      if (!v || v->empty() || std::filesystem::path(*v).is_absolute()) return;
+      t->insert_or_assign(key, std::filesystem::absolute(base / *v).lexically_normal().string());
+    };
+    absolute(resolved["toner"].as_table(), "cluster_file", "");
+    absolute(resolved["magnet"].as_table(), "map_file", "");
+    absolute(resolved["print"].as_table(), "file", std::filesystem::path(file).parent_path());
+    std::ostringstream ss;
+    ss << "# Complete resolved configuration (preset + file + --set): `nipdem run THIS_FILE --out DIR` repeats the run.\n"
+       << resolved << "\n";
+    c.resolved_toml = ss.str();
+  }
   // A resumed run may extend the end time and change the output cadence; nothing else
   // (e.g. the thread count changes the floating-point summation order).
   if (auto* run = root["run"].as_table()) {

@@ -211,8 +211,9 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
     }
     const double v = row["sleeve_speed_m_per_s"].get<double>();
     auto& s = by_speed[v];
-    s.label = fmt::format("v_h = {:.3g} m/min", v * 60);
+    s.label = fmt::format("sleeve speed {:.3g} m/min", v * 60);
     s.markers = true;
+    s.line_only_if_resolved = true;  // a line only where consecutive fronts differ by more than their spread
     s.x.push_back(row["gap_m"].get<double>() * 1e6);
     s.y.push_back(row["front_m"].get<double>() * 1e6);
     s.y_err.push_back(row["front_std_m"].get<double>() * 1e6);
@@ -294,8 +295,9 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   json rows = json::array();
   std::string csv = "r,removed,time_s,removed_per_100ms,reduction_speed_m_per_s,reduction_speed_stderr_m_per_s\n";
   io::Series s;
-  s.label = "removed in the observation time";
+  s.label = "particles removed in the observation time";
   s.markers = true;
+  s.line = false;  // one stochastic run per r: points, not a curve through them
   for (const auto& rec : sum.records) {
     if (!rec.ok) continue;
     json row = rec.result;
@@ -503,7 +505,8 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   json js = analysis::edge_sharpness_json(boot, curves.size());
   for (auto& [k, v] : js.items()) out[k] = v;
   analysis::write_coverage_csv(o.out / "coverage_average.csv", x, avg, fit);
-  io::write_plot_png(o.out / "coverage_average.png", analysis::coverage_plot(x, avg, fit, "Average coverage of printed lines (fig. 1.8 analogue)"));
+  io::write_plot_png(o.out / "coverage_average.png", analysis::coverage_plot(x, avg, fit, "Average coverage of printed lines (fig. 1.8 analogue)",
+                                                                              e.print.line_start_m, e.print.line_start_m + e.print.line_length_m));
   out["coverage_file"] = (o.out / "coverage_average.csv").string();
   return out;
 }

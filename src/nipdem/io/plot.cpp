@@ -93,6 +93,18 @@ void show_text_at(cairo_t* cr, const std::string& s, double x, double y, double 
 
 }  // namespace
 
+bool draws_line(const Series& se) {
+  if (!se.line) return false;
+  if (!se.line_only_if_resolved) return true;
+  // resolved: some pair of neighbouring points differs by more than their combined error bars
+  for (std::size_t i = 0; i + 1 < se.x.size() && i + 1 < se.y.size(); ++i) {
+    if (!std::isfinite(se.y[i]) || !std::isfinite(se.y[i + 1])) continue;
+    const double e0 = i < se.y_err.size() ? se.y_err[i] : 0.0, e1 = i + 1 < se.y_err.size() ? se.y_err[i + 1] : 0.0;
+    if (std::fabs(se.y[i + 1] - se.y[i]) > std::hypot(e0, e1)) return true;
+  }
+  return false;
+}
+
 std::array<double, 3> diverging_colour(double t) {
   t = std::clamp(t, -1.0, 1.0);  // display only: the data are never changed
   const std::array<double, 3> neg{0.13, 0.40, 0.67}, pos{0.70, 0.09, 0.17};
@@ -439,7 +451,7 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
       }
       cairo_stroke(cr);
     }
-    if (se.line) {
+    if (draws_line(se)) {
       cairo_set_line_width(cr, se.line_width);
       if (se.dashed) {
         const double d[] = {6.0, 4.0};
@@ -509,7 +521,7 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
       const auto c = colour_of(shown[k]);
       const double yc = by + pad + row * (k + 0.5);
       cairo_set_source_rgb(cr, c[0], c[1], c[2]);
-      if (se.line || !se.markers) {
+      if (draws_line(se) || !se.markers) {
         cairo_set_line_width(cr, se.line_width);
         if (se.dashed) {
           const double d[] = {6.0, 4.0};
@@ -542,6 +554,50 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
     throw std::runtime_error(where + ": cannot write PNG: " + cairo_status_to_string(st));
   }
   std::filesystem::rename(tmp, path);
+}
+
+std::string column_words(const std::string& column, double scale) {
+  struct Unit { const char* suffix; const char* unit; std::vector<std::pair<double, const char*>> scaled; };
+  static const std::vector<Unit> units = {
+      {"_m_per_s2", "m/s²", {}},
+      {"_m_per_s", "m/s", {{1e3, "mm/s"}}},
+      {"_m_per_min", "m/min", {}},
+      {"_kg_per_m3", "kg/m³", {}},
+      {"_Ns_per_m", "N s/m", {}},
+      {"_N_per_m", "N/m", {}},
+      {"_A_per_m", "A/m", {}},
+      {"_um", "µm", {}},
+      {"_ms", "ms", {}},
+      {"_Hz", "Hz", {}},
+      {"_deg", "°", {}},
+      {"_ohm", "Ω", {}},
+      {"_m", "m", {{1e6, "µm"}, {1e3, "mm"}, {1e9, "nm"}}},
+      {"_s", "s", {{1e3, "ms"}, {1e6, "µs"}}},
+      {"_N", "N", {{1e9, "nN"}, {1e12, "pN"}, {1e6, "µN"}}},
+      {"_V", "V", {}},
+      {"_J", "J", {}},
+      {"_F", "F", {}},
+      {"_T", "T", {{1e3, "mT"}}},
+  };
+  std::string words = column, unit;
+  for (const auto& u : units) {
+    const std::string suf = u.suffix;
+    if (column.size() > suf.size() && column.compare(column.size() - suf.size(), suf.size(), suf) == 0) {
+      words = column.substr(0, column.size() - suf.size());
+      unit = u.unit;
+      if (scale != 1.0) {
+        std::string to;
+        for (const auto& [f, name] : u.scaled)
+          if (std::fabs(f / scale - 1.0) < 1e-9) to = name;
+        unit = to.empty() ? fmt::format("{:g} {}", 1.0 / scale, u.unit) : to;
+      }
+      break;
+    }
+  }
+  for (char& ch : words)
+    if (ch == '_') ch = ' ';
+  if (unit.empty() && scale != 1.0) unit = fmt::format("x {:g}", scale);
+  return unit.empty() ? words : words + " [" + unit + "]";
 }
 
 }  // namespace nipdem::io

@@ -29,6 +29,9 @@ struct Series {
   std::vector<double> y;
   std::vector<double> y_err;      // empty, or same size as y: symmetric error bar half-length
   bool line = true;               // connect points
+  // Connect them only if the data resolve a trend: some neighbouring pair differs by more than
+  // their combined error bars (sqrt(e_i^2 + e_j^2)); otherwise markers only.
+  bool line_only_if_resolved = false;
   bool markers = false;           // draw a marker at each point
   bool dashed = false;
   double line_width = 1.8;        // [px]
@@ -66,6 +69,13 @@ struct PlotSpec {
 // Renders `spec` and writes a PNG atomically. Throws InputError on bad data, std::runtime_error
 // if Cairo or the file system fails.
 void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec);
+
+// Whether `series` is drawn with a connecting line (line, and line_only_if_resolved's rule).
+bool draws_line(const Series& series);
+
+// Axis or legend text for a CSV column named with its unit suffix, shown multiplied by
+// `scale`: "front_std_m" with 1e6 -> "front std [µm]", "coverage" -> "coverage".
+std::string column_words(const std::string& column, double scale = 1.0);
 
 // Diverging colour for t in [-1, 1] (clamped for display): blue at -1, white at 0, red at +1.
 std::array<double, 3> diverging_colour(double t);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -95,6 +96,43 @@ std::vector<double> Section::numbers(const std::string& key, std::size_t n, doub
   return out;
 }
 
+void Section::require(const std::string& key, const std::string& allowed) const {
+  if (!has(key)) throw_input(file_, key_path(key), "", "missing required key", allowed);
+}
+
+std::int64_t Section::integer(const std::string& key, std::int64_t lo, std::int64_t hi) {
+  require(key, fmt::format("[{}, {}]", lo, hi));
+  return integer(key, lo, hi, 0);
+}
+
+bool Section::boolean(const std::string& key) {
+  require(key, "true or false");
+  return boolean(key, false);
+}
+
+std::string Section::string(const std::string& key) {
+  require(key, "a string");
+  return string(key, std::string());
+}
+
+std::string Section::choice(const std::string& key, const std::vector<std::string>& allowed) {
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  require(key, list);
+  return choice(key, allowed, std::string());
+}
+
+std::vector<double> Section::numbers(const std::string& key, std::size_t n, double lo, double hi) {
+  require(key, n ? fmt::format("an array of {} numbers in {}", n, range_text(lo, hi)) : "an array of numbers");
+  return numbers(key, n, lo, hi, {});
+}
+
+void Section::record(const std::string& key, double value) {
+  if (t_ == &empty_) throw std::logic_error("Section::record: [" + path_ + "] is not part of the configuration");
+  used_.insert(key);
+  t_->insert_or_assign(key, value);
+}
+
 Section Section::sub(const std::string& key) {
   used_.insert(key);
   toml::node* n = t_->get(key);
@@ -125,6 +163,17 @@ toml::table parse_toml(const std::string& text, const std::string& file) {
   } catch (const toml::parse_error& e) {
     const auto& b = e.source().begin;
     throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", file, b.line, b.column, e.description()));
+  }
+}
+
+void merge_into(toml::table& base, const toml::table& over) {
+  for (const auto& [k, v] : over) {
+    toml::node* b = base.get(k);
+    if (b && b->is_table() && v.is_table()) {
+      merge_into(*b->as_table(), *v.as_table());
+    } else {
+      base.insert_or_assign(k, v);
+    }
   }
 }
 

@@ -25,6 +25,15 @@ class Section {
   std::string string(const std::string& key, const std::string& fallback);
   std::vector<double> numbers(const std::string& key, std::size_t n, double lo, double hi,
                               const std::vector<double>& fallback);
+  // Required forms: a missing key is an InputError ("missing required key").
+  std::int64_t integer(const std::string& key, std::int64_t lo, std::int64_t hi);
+  bool boolean(const std::string& key);
+  std::string choice(const std::string& key, const std::vector<std::string>& allowed);
+  std::string string(const std::string& key);
+  std::vector<double> numbers(const std::string& key, std::size_t n, double lo, double hi);
+  // Writes `value` under `key` (marking it used): records a value derived from other keys, so
+  // that the table becomes the complete resolved configuration. Needs a table that exists.
+  void record(const std::string& key, double value);
   // Sub-table (created empty if absent, so optional sections read defaults).
   Section sub(const std::string& key);
   std::vector<std::string> subtable_keys() const;
@@ -35,6 +44,7 @@ class Section {
   std::string key_path(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
  private:
+  void require(const std::string& key, const std::string& allowed) const;
   toml::table* t_;
   toml::table empty_;
   std::string file_, path_;
@@ -43,6 +53,9 @@ class Section {
 
 // Parses TOML text; syntax errors become InputError naming file, line and column.
 toml::table parse_toml(const std::string& text, const std::string& file);
+// Copies every key of `over` into `base`; tables merge key by key (recursively), any other
+// value replaces base's.
+void merge_into(toml::table& base, const toml::table& over);
 // Applies "a.b.c=value" overrides (value parsed as TOML: numbers, booleans, "strings", arrays).
 void apply_override(toml::table& root, const std::string& assignment, const std::string& file);
 
