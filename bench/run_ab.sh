@@ -11,7 +11,8 @@ set -euo pipefail
 A=$1 B=$2 ROUNDS=$3 KEY=$4
 shift 5
 # KEY = cpu_magnet / cpu_nomagnet (bench_nip): disc-steps per CPU second of that run, from its
-# discs=, cpu= and the header's steps= (robust on a loaded machine for 1 thread).
+# discs=, cpu= and the header's steps= (robust on a loaded machine for 1 thread); KEY = cpu_rate:
+# the same from a RESULT line's disc_steps_per_s, wall_s and cpu_s (bench_lammps_packing).
 value() {
   case "$KEY" in
     cpu_magnet|cpu_nomagnet)
@@ -20,6 +21,8 @@ value() {
         /^bench_nip/ {for (i=1;i<=NF;i++) if ($i ~ /^steps=/) {sub(/.*=/,"",$i); steps=$i}}
         $0 ~ tag && !done {for (i=1;i<=NF;i++) {if ($i ~ /^discs=/) {d=$i; sub(/.*=/,"",d)} if ($i ~ /^cpu=/) {c=$i; sub(/.*=/,"",c)}}
                            printf "%.4g\n", d*steps/c; done=1}' ;;
+    cpu_rate)  # any RESULT line with disc_steps_per_s, wall_s and cpu_s (bench_lammps_packing)
+      "$@" | awk '/^RESULT/ {for (i=1;i<=NF;i++) {split($i, kv, "="); v[kv[1]]=kv[2]} printf "%.4g\n", v["disc_steps_per_s"]*v["wall_s"]/v["cpu_s"]}' ;;
     *) "$@" | awk -v k="$KEY" '/^RESULT/ {for (i=1;i<=NF;i++) if (index($i, k"=")==1) {sub(/.*=/,"",$i); print $i}}' ;;
   esac
 }
