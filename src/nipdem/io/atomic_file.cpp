@@ -29,12 +29,25 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
   fs::rename(tmp, path);
 }
 
-std::string read_file(const std::filesystem::path& path) {
+std::string read_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const auto st = fs::status(path, ec);  // follows symlinks
+  if (ec || !fs::exists(st)) throw InputError(path.string() + ": cannot open file (missing or unreadable)");
+  if (fs::is_directory(st)) throw InputError(path.string() + ": is a folder, not a file");
+  if (!fs::is_regular_file(st)) throw InputError(path.string() + ": is not a regular file (a device, FIFO or socket)");
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw InputError(path.string() + ": cannot open file (missing or unreadable)");
+  if (size > max_bytes)
+    throw InputError(path.string() + ": file of " + std::to_string(size) + " bytes is larger than the " +
+                     std::to_string(max_bytes >> 20) + " MiB nipdem reads (wrong file?)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open file (missing or unreadable)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  std::string s(static_cast<std::size_t>(size), '\0');
+  in.read(s.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size || in.bad())
+    throw InputError(path.string() + ": read failed (file changed while being read?)");
+  return s;
 }
 
 }  // namespace nipdem::io
