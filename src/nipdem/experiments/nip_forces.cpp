@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <unordered_map>
 
@@ -130,15 +131,26 @@ void MagnetForce::field_pass(const BodyStore& b) {
   // Tiles are built serially first; the parallel loop only reads them. Each particle is
   // independent, so the result does not depend on the thread count.
   for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
+  // No exception may leave an OpenMP region (it would end the program): a failure (e.g. a field
+  // map asked outside its range, InputError) is caught per particle and the one of the lowest
+  // index rethrown after the loop, so any thread count reports the same error as one thread.
+  std::size_t first_bad = n;
+  std::exception_ptr error;
 #pragma omp parallel for schedule(static) num_threads(nt)
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 p{b.x[i], b.y[i]};
-    const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
-    moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
-    const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
-    ffx_[i] = f.x;
-    ffy_[i] = f.y;
+    try {
+      const Vec2 p{b.x[i], b.y[i]};
+      const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
+      moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
+      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
+      ffx_[i] = f.x;
+      ffy_[i] = f.y;
+    } catch (...) {
+#pragma omp critical(nipdem_magnet_field_pass_error)
+      if (i < first_bad) { first_bad = i; error = std::current_exception(); }
+    }
   }
+  if (error) std::rethrow_exception(error);
 }
 
 // Dipole-dipole forces (eqs. 2.4.38-2.4.39) between the induced moments within the cut-off:
