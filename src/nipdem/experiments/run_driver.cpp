@@ -72,10 +72,14 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
   const double dt = run.time_step().dt;
   if (opt.resume) {
     run.restore(io::read_file(ckpt, io::kMaxCheckpointBytes), ckpt.string());
-    if (!(cfg.end_time > run.sim().time() + 0.5 * dt))
+    // An end time before the checkpoint is an error; one at the checkpoint's time only finishes
+    // the outputs of a run killed after its last checkpoint (no summary yet), else nothing is left.
+    const double tc = run.sim().time();
+    if (cfg.end_time < tc - 0.5 * dt || (cfg.end_time < tc + 0.5 * dt && fs::exists(out / "summary.json")))
       throw_input(cfg.file, "run.end_time_s", fmt::format("{:g}", cfg.end_time),
-                  fmt::format("the checkpoint {} is at t = {:g} s: nothing left to run", ckpt.string(), run.sim().time()),
-                  fmt::format("> {:g} s (the checkpoint's time plus half a step)", run.sim().time() + 0.5 * dt));
+                  fmt::format("the checkpoint {} is at t = {:g} s{}: nothing left to run", ckpt.string(), tc,
+                              cfg.end_time < tc - 0.5 * dt ? "" : " and the run's summary.json exists"),
+                  fmt::format("> {:g} s (the checkpoint's time plus half a step)", tc + 0.5 * dt));
     if (fs::exists(out / "frames.json")) {
       const fs::path fj = out / "frames.json";
       try {

@@ -1,6 +1,8 @@
 #include "nipdem/io/atomic_file.hpp"
 
+#include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -9,6 +11,29 @@
 #include "nipdem/core/error.hpp"
 
 namespace nipdem::io {
+
+namespace {
+// Fault injection for the kill-at-many-moments test (docs/reliability.md): with
+// NIPDEM_FAULT_KILL_AT_WRITE = "N:before" (or "N:after") the process kills itself with SIGKILL
+// at its N-th atomic write, between the temp file's fsync and the rename (or just after the
+// rename). Read once; costs one comparison per write otherwise.
+struct KillAtWrite {
+  long n = -1;
+  bool before = true;
+  long count = 0;
+  KillAtWrite() {
+    if (const char* e = std::getenv("NIPDEM_FAULT_KILL_AT_WRITE")) {
+      char* end = nullptr;
+      n = std::strtol(e, &end, 10);
+      before = !(end && std::string_view(end) == ":after");
+    }
+  }
+};
+KillAtWrite& kill_at_write() {
+  static KillAtWrite k;
+  return k;
+}
+}  // namespace
 
 void write_file_atomic(const std::filesystem::path& path, std::string_view content) {
   namespace fs = std::filesystem;
@@ -26,7 +51,11 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
       throw std::runtime_error("cannot write '" + tmp.string() + "' (disk full?)");
     }
   }
+  auto& k = kill_at_write();
+  const bool kill_now = k.n > 0 && ++k.count == k.n;
+  if (kill_now && k.before) ::raise(SIGKILL);
   fs::rename(tmp, path);
+  if (kill_now) ::raise(SIGKILL);
 }
 
 std::string read_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
