@@ -177,6 +177,12 @@ TEST(HostileCli, BadOptionsAreRefusedNamingTheOption) {
       {"force electric --radius -1 --voltage 100 --gap 1e-6 --json", {"radius"}},
       {"force dipole --moment nan --distance 1e-5 --angle 0 --json", {"--moment"}},
       {"force dipole --moment 1e-13 --distance 1e-4 --angle 0 --pigments 3 --samples -5 --json", {"samples", "-5"}},
+      // results that would overflow to null in the JSON (exit 0 before)
+      {"force electric --radius 1e300 --voltage 100 --gap 1e-6 --json", {"--radius"}},
+      {"force electric --radius 5e-6 --voltage 1e308 --gap 1e-6 --json", {"--voltage"}},
+      {"force electric --radius 5e-6 --voltage 100 --gap 1e300 --json", {"--gap"}},
+      {"force dipole --moment 1e300 --distance 1e-4 --angle 0 --json", {"--moment"}},
+      {"force dipole --moment 1e-13 --distance 1e300 --angle 0 --json", {"--distance"}},
       {"params collision --preset nope --json", {"nope"}},
       {"rc response --R nan --Rd 1e6 --C 1e-12 --voltage 1 --freq 1:10:1 --json", {"--R"}},
       {"calibrate restitution --y0 inf --y1 1e-3 --radius 5e-6 --density 1500 --viscosity 1.8e-5 --json", {"--y0"}},
@@ -292,8 +298,9 @@ TEST(HostileCli, ResumeRefusesDamagedCheckpointsAndEmptyWork) {
   cases.push_back({resume(variant("earlier_end", [](const fs::path&) {}), "1e-6"), {"run.end_time_s", "checkpoint"}});
   // another configuration
   cases.push_back({resume(variant("other_cfg", [](const fs::path&) {})) + " --set adhesion.cohesion_ratio=3", {"different configuration"}});
-  // --out that is a file
+  // --out that is a file, or a folder that cannot be created (exit 1 before)
   cases.push_back({base + " --out " + (good / "summary.json").string(), {"summary.json", "--out"}});
+  cases.push_back({base + " --out /proc/nipdem_cannot_be_here", {"/proc/nipdem_cannot_be_here", "--out"}});
   expect_refused(cases, "hostile_resume");
   fs::remove_all(d);
 }

@@ -48,7 +48,11 @@ void remove_stale_temp_files(const fs::path& out) {
 json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in) {
   RunOptions opt = opt_in;
   if (fs::exists(out) && !fs::is_directory(out)) throw InputError(out.string() + ": --out names a file, not a folder");
-  fs::create_directories(out);
+  {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw InputError(out.string() + ": --out folder cannot be created (" + ec.message() + ")");
+  }
   remove_stale_temp_files(out);
   const fs::path ckpt = out / "checkpoint.bin";
   // A run killed before its first checkpoint has nothing worth keeping: --resume starts it
