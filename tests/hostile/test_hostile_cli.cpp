@@ -183,6 +183,8 @@ TEST(HostileCli, BadOptionsAreRefusedNamingTheOption) {
       {"force electric --radius 5e-6 --voltage 100 --gap 1e300 --json", {"--gap"}},
       {"force dipole --moment 1e300 --distance 1e-4 --angle 0 --json", {"--moment"}},
       {"force dipole --moment 1e-13 --distance 1e300 --angle 0 --json", {"--distance"}},
+      {"calibrate restitution --y0 1e-3 --y1 1e-3 --radius 1e300 --density 1500 --viscosity 1.8e-5 --json", {"--radius"}},
+      {"rc response --R 1e300 --Rd 1e300 --C 1e300 --voltage 1e300 --freq 1:10:1 --json", {"rc response"}},
       {"params collision --preset nope --json", {"nope"}},
       {"rc response --R nan --Rd 1e6 --C 1e-12 --voltage 1 --freq 1:10:1 --json", {"--R"}},
       {"calibrate restitution --y0 inf --y1 1e-3 --radius 5e-6 --density 1500 --viscosity 1.8e-5 --json", {"--y0"}},
