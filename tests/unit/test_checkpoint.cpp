@@ -222,6 +222,17 @@ TEST(RunCheckpoint, IdenticalRunsWriteIdenticalBytesAndDamageIsRefusedNamingTheF
   refused("NIPDEMRUN3" + a.substr(10), "older nipdem");
 }
 
+TEST(RunCheckpoint, HugeCountersAreRefusedWithoutOverflow) {
+  // Found by fuzz_checkpoint (UBSan): removal counters near 2^62 overflowed their sum.
+  std::string payload(io::open_checkpoint(run_checkpoint(2e-6), "x"));
+  const std::size_t removed_at = 10 + 2 * 8 + 4 * 8 + 2 * 8;  // tag, keys, rng, inserted counters
+  const std::int64_t huge = std::int64_t{1} << 62;
+  for (int k = 0; k < 2; ++k) std::memcpy(payload.data() + removed_at + 8 * k, &huge, 8);
+  experiments::NipRun target(small_config());
+  const std::string m = message_of([&] { target.restore(io::seal_checkpoint(payload), "x"); });
+  EXPECT_TRUE(contains(m, "particle counter")) << m;
+}
+
 TEST(RunCheckpoint, ResealedRandomDamageNeverCrashes) {
   // Damage the checksum cannot see (a payload re-sealed after the change, as a buggy writer or a
   // crafted file would): each load either succeeds with a checked state or throws InputError.

@@ -379,8 +379,9 @@ void NipRun::restore_state(std::istream& in, const std::string& where) {
     binary::get(in, inserted_roller);
     for (auto& r : removed) binary::get(in, r);
     binary::get(in, area_debt);
-    if (inserted < 0 || inserted_roller < 0 || removed[0] < 0 || removed[1] < 0 || removed[2] < 0)
-      bad("a particle counter is negative");
+    constexpr std::int64_t kMaxCount = std::int64_t{1} << 50;  // far above any run; their sum cannot overflow
+    for (const std::int64_t c : {inserted, inserted_roller, removed[0], removed[1], removed[2]})
+      if (c < 0 || c > kMaxCount) bad(fmt::format("a particle counter ({}) is outside [0, 2^50]", c));
     if (!std::isfinite(area_debt)) bad(fmt::format("inflow area debt {} is not finite", area_debt));
     std::uint64_t n;
     binary::get(in, n);

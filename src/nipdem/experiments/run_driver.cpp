@@ -29,7 +29,7 @@ std::string removals_csv(const NipRun& run) {
 // Temp files "<name>.tmp.<pid>" of a writer that no longer runs (killed between the write and
 // the rename of write_file_atomic): removed, so a killed run leaves nothing behind after the next.
 void remove_stale_temp_files(const fs::path& out) {
-  for (const fs::path dir : {out, out / "particles"}) {
+  for (const fs::path& dir : {out, out / "particles"}) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) continue;
     for (const auto& e : fs::directory_iterator(dir, ec)) {
