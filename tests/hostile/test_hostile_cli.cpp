@@ -70,7 +70,7 @@ TEST(HostileCli, InputFilesThatAreNotRegularFilesOrTooLargeAreRefused) {
   fs::resize_file(huge, 300ull << 20);  // sparse: 300 MiB without using the disk
   std::string bin(4096, '\0');
   nipdem::Rng rng(3);
-  for (auto& ch : bin) ch = static_cast<char>(rng.uniform(0, 255.99));
+  for (auto& ch : bin) ch = static_cast<char>(static_cast<unsigned char>(rng.uniform(0, 255.99)));
   const std::string binary = write(d / "binary.toml", bin);
   const std::string out = " --out " + (d / "out").string();
   expect_refused({
