@@ -1,10 +1,12 @@
 // `nipdem calibrate restitution`: normal restitution coefficient from a drop test with Stokes
 // drag (thesis §4.2.1, eqs. 4.2.1–4.2.6). See src/nipdem/experiments/calibrate_restitution.hpp.
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "nipdem/experiments/calibrate_restitution.hpp"
+#include "nipdem/core/error.hpp"
 #include "registry.hpp"
 
 namespace {
@@ -28,7 +30,17 @@ nipdem::cli::Register reg([](CLI::App& app) {
       ->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
+    // Physical ranges (a drop test of a particle), so that no result overflows into null.
+    const char* w = "calibrate restitution";
+    nipdem::require_range(w, "--y0", o->p.y0_m, 1e-9, 100.0);
+    nipdem::require_range(w, "--radius", o->p.radius_m, 1e-9, 1e-1);
+    nipdem::require_range(w, "--density", o->p.density_kg_per_m3, 1e-3, 1e5);
+    nipdem::require_range(w, "--viscosity", o->p.viscosity_Pa_s, 1e-9, 1e3);
+    nipdem::require_range(w, "--gravity", o->p.gravity_m_per_s2, 1e-3, 1e3);
     const auto r = nipdem::calibrate::drop_test_restitution(o->p);
+    for (double v : {r.restitution, r.impact_speed_m_per_s, r.rebound_speed_m_per_s, r.fall_time_s, r.beta_s})
+      if (!std::isfinite(v))
+        nipdem::throw_input(w, "--y0, --y1, --radius, --density, --viscosity", "", "the drop test is not computable for these inputs");
     if (o->json) {
       nlohmann::json j{{"restitution", r.restitution},
                        {"restitution_no_drag", r.restitution_no_drag},

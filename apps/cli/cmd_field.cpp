@@ -24,7 +24,17 @@ struct Common {
   double tip_depth = -1.0;  // < 0: preset default
   double br = -100.0;       // < -99: preset default
   bool json = false;
+  // Given on the command line? (A given value is checked, never taken for "not given".)
+  CLI::Option *radius_opt = nullptr, *tip_opt = nullptr, *br_opt = nullptr;
 };
+
+// Options that were given are checked against their physical range (never ignored, issue 21).
+void check_common(const Common& c, const std::string& where) {
+  if (c.preset != "black" && c.preset != "color") throw_input(where, "--preset", c.preset, "unknown preset", "black, color");
+  if (c.radius_opt && c.radius_opt->count()) require_range(where, "--radius", c.radius, 1e-7, 1e-3);
+  if (c.tip_opt && c.tip_opt->count()) require_range(where, "--tip-depth", c.tip_depth, 0.0, 5e-3);
+  if (c.br_opt && c.br_opt->count()) require_range(where, "--br", c.br, -2.5, 2.5);
+}
 
 struct Setup {
   std::unique_ptr<magnet::MagnetField> field;
@@ -37,19 +47,20 @@ Setup make_setup(const Common& c) {
   s.toner = magnet::preset_toner(c.preset);
   s.radius = c.radius == 0.0 ? magnet::preset_d50_radius(c.preset) : c.radius;
   require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  const bool custom = c.tip_depth >= 0.0 || c.br > -99.0;
+  const bool given_tip = c.tip_opt && c.tip_opt->count(), given_br = c.br_opt && c.br_opt->count();
+  const bool custom = given_tip || given_br;
   if (!c.map.empty()) {
     if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
     s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
   } else if (custom && c.preset == "black") {
     magnet::KnifeParams k;
-    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
-    if (c.br > -99.0) k.blade_Br_T = c.br;
+    if (given_tip) k.tip_depth_m = c.tip_depth;
+    if (given_br) k.blade_Br_T = c.br;
     s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
   } else if (custom && c.preset == "color") {
     magnet::ColorPoleParams k;
-    if (c.tip_depth >= 0.0) k.tip_depth_m = c.tip_depth;
-    if (c.br > -99.0) k.Br_T = c.br;
+    if (given_tip) k.tip_depth_m = c.tip_depth;
+    if (given_br) k.Br_T = c.br;
     s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
   } else {
     s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
@@ -60,9 +71,9 @@ Setup make_setup(const Common& c) {
 void add_common(CLI::App* sub, Common& c) {
   sub->add_option("--preset", c.preset, "magnet and toner preset: black or color")->capture_default_str();
   sub->add_option("--map", c.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
-  sub->add_option("--radius", c.radius, "toner radius [m] (default: d50/2 of the preset toner, Table 2.1)");
-  sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m]");
-  sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T]");
+  c.radius_opt = sub->add_option("--radius", c.radius, "toner radius [m] in [1e-7, 1e-3] (default: d50/2 of the preset toner, Table 2.1)");
+  c.tip_opt = sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m], in [0, 5e-3]");
+  c.br_opt = sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T], in [-2.5, 2.5]");
   sub->add_flag("--json", c.json, "print one JSON object on stdout");
 }
 
@@ -92,8 +103,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->add_option("--x", po->x, "x [m] along the process direction, 0 at the magnet edge")->required();
   probe->add_option("--y", po->y, "y [m] above the imaging-roller surface")->required();
   probe->callback([po] {
-    require_range("field probe", "x_m", po->x, -1.0, 1.0);
-    require_range("field probe", "y_m", po->y, -1.0, 1.0);
+    require_range("field probe", "--x", po->x, -1.0, 1.0);
+    require_range("field probe", "--y", po->y, -1.0, 1.0);
+    check_common(po->c, "field probe");
     const Setup s = make_setup(po->c);
     const auto smp = s.field->at({po->x, po->y});
     const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
@@ -139,10 +151,17 @@ nipdem::cli::Register reg([](CLI::App& app) {
   exp->add_option("--ny", eo->ny, "nodes along y (>= 5)")->capture_default_str();
   exp->add_option("--out", eo->out, "output CSV file (written atomically)")->required();
   exp->callback([eo] {
-    require_range("field export", "nx", eo->nx, 5, 1e5);
-    require_range("field export", "ny", eo->ny, 5, 1e5);
-    if (!(eo->x1 > eo->x0)) throw_input("field export", "x1_m", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
-    if (!(eo->y1 > eo->y0)) throw_input("field export", "y1_m", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
+    require_range("field export", "--nx", eo->nx, 5, 1e5);
+    require_range("field export", "--ny", eo->ny, 5, 1e5);
+    if (eo->preset != "black" && eo->preset != "color") throw_input("field export", "--preset", eo->preset, "unknown preset", "black, color");
+    require_range("field export", "--x0", eo->x0, -1.0, 1.0);
+    require_range("field export", "--x1", eo->x1, -1.0, 1.0);
+    require_range("field export", "--y0", eo->y0, -1.0, 1.0);
+    require_range("field export", "--y1", eo->y1, -1.0, 1.0);
+    if (static_cast<double>(eo->nx) * eo->ny > 1e7)
+      throw_input("field export", "--nx, --ny", fmt::format("{} x {}", eo->nx, eo->ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
+    if (!(eo->x1 > eo->x0)) throw_input("field export", "--x1", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
+    if (!(eo->y1 > eo->y0)) throw_input("field export", "--y1", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
     const auto f = magnet::preset_field(eo->preset);
     io::write_file_atomic(eo->out, io::field_to_csv(f, eo->x0, eo->x1, eo->nx, eo->y0, eo->y1, eo->ny,
                                                     f.describe() + ", magnet frame (see docs/magnetic.md)"));
@@ -158,11 +177,12 @@ nipdem::cli::Register reg([](CLI::App& app) {
   line->add_option("--n", lo->n, "number of points")->capture_default_str();
   line->add_option("--out", lo->out, "output CSV file (written atomically)")->required();
   line->callback([lo] {
-    require_range("field line", "n", lo->n, 2, 1e6);
-    require_range("field line", "y_m", lo->y, -1.0, 1.0);
-    require_range("field line", "x0_m", lo->x0, -1.0, 1.0);
-    require_range("field line", "x1_m", lo->x1, -1.0, 1.0);
-    if (!(lo->x1 > lo->x0)) throw_input("field line", "x1_m", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
+    require_range("field line", "--n", lo->n, 2, 1e6);
+    require_range("field line", "--y", lo->y, -1.0, 1.0);
+    require_range("field line", "--x0", lo->x0, -1.0, 1.0);
+    require_range("field line", "--x1", lo->x1, -1.0, 1.0);
+    if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
+    check_common(lo->c, "field line");
     const Setup s = make_setup(lo->c);
     std::string csv = fmt::format("# {}; toner preset {}, R = {:g} m; force F = (m.grad)B, m = m(B) of eq. 4.5.1\n",
                                   s.field->describe(), lo->c.preset, s.radius);

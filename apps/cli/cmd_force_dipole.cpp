@@ -2,11 +2,13 @@
 // between two magnetised toner spheres whose moment sits in one central pigment ("cherry pit") or in
 // N random point pigments. See src/nipdem/models/dipole_pigments.hpp and docs/magnetic.md.
 #include <cmath>
+#include <fmt/format.h>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/models/dipole_pigments.hpp"
+#include "nipdem/core/error.hpp"
 #include "registry.hpp"
 
 namespace {
@@ -34,6 +36,10 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
     using namespace nipdem;
+    // Physical ranges (far beyond toner's: m ~ 4e-11 A m^2, d ~ 13 um), so no result overflows.
+    require_range("force dipole", "--moment", o->moment, -1e-3, 1e-3);
+    require_range("force dipole", "--distance", o->distance, 1e-9, 1.0);
+    require_range("force dipole", "--radius", o->radius, 1e-9, 1e-2);
     dipole::PigmentStudyParams p;
     p.moment_Am2 = o->moment;
     p.distance_m = o->distance;
@@ -46,6 +52,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
     // Cherry-pit reference (eq. 2.4.39 with both moments at the centres), for comparison.
     const Vec2 m{o->moment * std::cos(p.angle_rad), o->moment * std::sin(p.angle_rad)};
     const double cherry = norm(dipole::dipole_force(m, m, {o->distance, 0.0}));
+    if (!std::isfinite(cherry) || !std::isfinite(r.force_mean_vec_abs_N))
+      throw_input("force dipole", "--moment, --distance", fmt::format("{:g} A m^2, {:g} m", o->moment, o->distance),
+                  "the force is not representable for these inputs");
     if (o->json) {
       nlohmann::json j{{"moment_Am2", o->moment},
                        {"distance_m", o->distance},

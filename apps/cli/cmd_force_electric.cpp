@@ -1,11 +1,14 @@
 // `nipdem force electric`: force on a grounded conducting sphere at a gap from a plate on
 // voltage V (thesis §2.5.3). See docs/electric.md.
+#include <cmath>
+#include <fmt/format.h>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/models/electric_force.hpp"
+#include "nipdem/core/error.hpp"
 #include "registry.hpp"
 
 namespace {
@@ -41,9 +44,16 @@ nipdem::cli::Register reg([](CLI::App& app) {
     p.model = parse_force_model(o->model, "force electric", "--model");
     p.approx_coefficient = o->approx_coefficient;
     p.validate();
+    // Physical ranges (far beyond toner's), so that no result overflows into null (issue 21).
+    nipdem::require_range("force electric", "--radius", o->radius, 1e-9, 1e-2);
+    nipdem::require_range("force electric", "--gap", o->gap, 1e-12, 1.0);
+    nipdem::require_range("force electric", "--voltage", o->voltage, -1e6, 1e6);
     const double d = o->layer ? effective_gap(o->gap, o->layer_thickness, o->layer_eps) : o->gap;
     const double F = force(p, o->radius, o->voltage, d);
     const double Fexact = force_exact(o->radius, o->voltage, d);
+    if (!std::isfinite(F) || !std::isfinite(Fexact))
+      nipdem::throw_input("force electric", "--radius, --gap, --voltage", fmt::format("{:g} m, {:g} m, {:g} V", o->radius, o->gap, o->voltage),
+                          "the force is not representable for these inputs");
     if (o->json) {
       nlohmann::json j;
       j["force_N"] = F;

@@ -1,5 +1,6 @@
 // `nipdem ldc verify [--json]`: reruns the LDC verification problems of thesis §3.8-3.10.
 // `nipdem ldc solve SETUP.{json,toml} [--json]`: solves one disc configuration (see docs/ldc.md).
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <toml++/toml.h>
@@ -73,7 +74,11 @@ nipdem::ldc::Params read_params(const json& j, std::vector<nipdem::ldc::Disc>& d
   auto integer = [&](const json& o, const char* key, int& v) {
     if (!o.contains(key)) return;
     if (!o[key].is_number_integer()) nipdem::throw_input(where, key, o[key].dump(), "must be an integer");
-    v = o[key].get<int>();
+    const auto w = o[key].get<std::int64_t>();
+    if (o[key].is_number_unsigned() && o[key].get<std::uint64_t>() > static_cast<std::uint64_t>(INT32_MAX))
+      nipdem::throw_input(where, key, o[key].dump(), "integer too large", "[-2^31, 2^31)");
+    if (w < INT32_MIN || w > INT32_MAX) nipdem::throw_input(where, key, o[key].dump(), "integer too large", "[-2^31, 2^31)");
+    v = static_cast<int>(w);
   };
   if (!j.is_object()) nipdem::throw_input(where, "", "", "setup must be a JSON object");
   if (j.contains("box")) {
@@ -135,17 +140,25 @@ void run_solve(const std::string& path, bool as_json) {
   }
   std::vector<Disc> discs;
   const Params p = read_params(j, discs, path);
-  LdcSolver solver(p);
-  const SolveStats& st = solver.solve(discs);
+  // The solver names its component ("ldc"); a setup error must name the file as well.
+  auto named = [&](const auto& f) {
+    try {
+      return f();
+    } catch (const nipdem::InputError& e) {
+      throw nipdem::InputError(path + ": " + e.what());
+    }
+  };
+  auto solver = named([&] { return std::make_unique<LdcSolver>(p); });
+  const SolveStats& st = named([&]() -> const SolveStats& { return solver->solve(discs); });
   json out;
   out["iterations"] = st.iterations;
   out["converged"] = st.converged;
   out["discs"] = json::array();
-  for (int k = 0; k < solver.disc_count(); ++k) {
-    const auto f = solver.force(k);
-    out["discs"].push_back({{"potential_V", solver.potential(k)},
+  for (int k = 0; k < solver->disc_count(); ++k) {
+    const auto f = solver->force(k);
+    out["discs"].push_back({{"potential_V", solver->potential(k)},
                             {"force_N_per_m", {f.x, f.y}},
-                            {"method", to_string(solver.method(k))}});
+                            {"method", to_string(solver->method(k))}});
   }
   if (as_json) {
     nipdem::cli::print_json(out.dump());
@@ -153,9 +166,9 @@ void run_solve(const std::string& path, bool as_json) {
   }
   std::printf("LDC: %d iterations, converged: %s\n%4s %14s %14s %14s  %s\n", st.iterations, st.converged ? "yes" : "no",
               "k", "g [V]", "Fx [N/m]", "Fy [N/m]", "local method");
-  for (int k = 0; k < solver.disc_count(); ++k) {
-    const auto f = solver.force(k);
-    std::printf("%4d %14.6e %14.6e %14.6e  %s\n", k, solver.potential(k), f.x, f.y, to_string(solver.method(k)));
+  for (int k = 0; k < solver->disc_count(); ++k) {
+    const auto f = solver->force(k);
+    std::printf("%4d %14.6e %14.6e %14.6e  %s\n", k, solver->potential(k), f.x, f.y, to_string(solver->method(k)));
   }
 }
 

@@ -1,6 +1,7 @@
 // `nipdem rc response` (forward model of the probe circuit, thesis eqs. 4.7.1–4.7.7) and
 // `nipdem calibrate rc` (least-squares fit of R, Rd, C to measured amplitude/phase).
 #include <cmath>
+#include <fmt/format.h>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -50,11 +51,19 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
     o->p.validate();
+    // Physical ranges (the thesis' circuit: R ~ 1e6, Rd >= 1e24 ohm, C ~ 1e-12 F) with wide
+    // margins, so that no amplitude or phase overflows into null.
+    nipdem::require_range("rc response", "--R", o->p.R_ohm, 1e-3, 1e30);
+    nipdem::require_range("rc response", "--Rd", o->p.Rd_ohm, 1e-3, 1e40);
+    nipdem::require_range("rc response", "--C", o->p.C_F, 1e-24, 1.0);
+    nipdem::require_range("rc response", "--voltage", o->voltage, -1e6, 1e6);
     const auto fs = nipdem::probe::parse_frequency_range(o->freq);
     nlohmann::json rows = nlohmann::json::array();
     if (!o->json) std::printf("%14s %16s %12s\n", "frequency_Hz", "amplitude_V", "phase_deg");
     for (double f : fs) {
       const auto r = nipdem::probe::response(o->p, o->voltage, f);
+      if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))
+        nipdem::throw_input("rc response", "--R, --Rd, --C, --voltage", fmt::format("at {:g} Hz", f), "the response is not computable for these inputs");
       if (o->json) {
         rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
       } else {

@@ -1,5 +1,7 @@
 // nipdem: one executable, subcommands registered by the cmd_*.cpp files (see registry.hpp).
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <sstream>
@@ -61,6 +63,47 @@ void finish_report(const nlohmann::json& j, const std::filesystem::path& out, co
   }
 }
 
+namespace {
+// Every numeric option of every command accepts only what its type can hold exactly: a finite
+// decimal number for FLOAT (no nan/inf: CLI11 would pass them on), a plain decimal integer for
+// INT/UINT (CLI11 would read "-1" as 2^64-1 for an unsigned option and "010" as octal 8). The
+// commands then check their ranges; this makes sure a NaN never reaches them silently.
+bool plain_integer(const std::string& s, bool allow_sign) {
+  std::size_t i = 0;
+  if (allow_sign && i < s.size() && (s[i] == '-' || s[i] == '+')) ++i;
+  if (i == s.size() || s.size() - i > 19) return false;
+  if (s[i] == '0' && s.size() - i > 1) return false;  // no octal / hex look-alikes
+  for (; i < s.size(); ++i) if (s[i] < '0' || s[i] > '9') return false;
+  return true;
+}
+void harden_numeric_options(CLI::App* app) {
+  for (CLI::Option* o : app->get_options()) {
+    const std::string t = o->get_type_name();
+    if (t == "FLOAT") {
+      o->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(x)) return "'" + v + "' is not a finite number";
+            return {};
+          },
+          "", "finite"));
+    } else if (t == "INT" || t == "UINT") {
+      const bool sign = t == "INT";
+      o->check(CLI::Validator(
+          [sign](std::string& v) -> std::string {
+            if (!plain_integer(v, sign))
+              return "'" + v + "' is not a plain decimal integer" + std::string(sign ? "" : " >= 0") +
+                     " (no leading zeros: they would be read as octal)";
+            return {};
+          },
+          "", "integer"));
+    }
+  }
+  for (CLI::App* s : app->get_subcommands([](CLI::App*) { return true; })) harden_numeric_options(s);
+}
+}  // namespace
+
 }  // namespace nipdem::cli
 
 int main(int argc, char** argv) {
@@ -69,6 +112,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("nipdem ") + nipdem::kVersion + " (" + nipdem::kGitHash + ")");
   for (auto& reg : nipdem::cli::registry()) reg(app);
+  nipdem::cli::harden_numeric_options(&app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include "nipdem/core/rng.hpp"
+#include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;
 using namespace nipdem::experiments;
@@ -93,5 +95,31 @@ TEST(NipMagnetForce, ThreadedDipolePassEqualsSerial) {
   for (int i = 0; i < 120; ++i) {
     EXPECT_NEAR(f1.dipole_fx()[i], f2.dipole_fx()[i], 1e-12 * scale);
     EXPECT_NEAR(f1.dipole_fy()[i], f2.dipole_fy()[i], 1e-12 * scale);
+  }
+}
+
+TEST(NipMagnetForce, AMapAskedOutsideItsRangeFailsCleanlyOnAnyThreadCount) {
+  // A failure inside the threaded field pass (here: a body outside the field map) must come out
+  // of the OpenMP region as the same InputError as with one thread, never std::terminate.
+  auto field = std::make_shared<io::FieldMap>(io::FieldMap::sample(magnet::preset_field("black"), -200e-6, 200e-6, 41, 0.0, 200e-6, 21));
+  BodyStore b = bodies(64, 9);
+  b.x[40] = 500e-6;  // outside the map
+  b.x[50] = -600e-6;
+  for (int threads : {1, 2}) {
+    MagnetConfig c;
+    c.dipole_dipole = false;
+    c.threads = threads;
+    MagnetForce f(field, c);
+    DiscStore d;
+    std::vector<double> fx(64, 0.0), fy(64, 0.0), tq(64, 0.0);
+    std::string msg;
+    try {
+      f.add(b, d, 0.0, fx, fy, tq);
+    } catch (const InputError& e) {
+      msg = e.what();
+    }
+    SCOPED_TRACE(threads);
+    EXPECT_NE(msg.find("outside the field map"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("(0.0005, "), std::string::npos) << "the lowest index is reported: " << msg;
   }
 }

@@ -10,7 +10,6 @@
 
 #include <omp.h>
 
-#include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 
@@ -682,63 +681,6 @@ Energy Simulation::energy() const {
   return e;
 }
 
-// ---- checkpoint serialisation (raw little-endian doubles; same binary, same machine kind) ----
-namespace {
-constexpr std::uint64_t kMagic = 0x314b43504d454450ULL;  // "PDEMPCK1"
-using binary::get;
-using binary::get_vec;
-using binary::put;
-using binary::put_vec;
-}  // namespace
-
-void Simulation::save(std::ostream& o) const {
-  put(o, kMagic);
-  put(o, time_); put(o, step_); put(o, next_id_);
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
-                  &b_.mass, &b_.inertia, &b_.size}) put_vec(o, *v);
-  put_vec(o, b_.id); put_vec(o, b_.first_disc); put_vec(o, b_.n_discs); put_vec(o, b_.tag);
-  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
-    put_vec(o, *v);
-  put_vec(o, d_.body); put_vec(o, d_.wall_key); put_vec(o, d_.wall_eta); put_vec(o, d_.wall_slide);
-  put_vec(o, nlist_.row_start_); put_vec(o, nlist_.nbr_); put_vec(o, nlist_.eta_); put_vec(o, nlist_.slide_);
-  const std::uint64_t nw = walls_.size();
-  put(o, nw);
-  for (const auto& w : walls_) put(o, w.angle);
-  const std::uint64_t np = prov_fx_.size();
-  put(o, np);
-  for (std::size_t k = 0; k < np; ++k) { put_vec(o, prov_fx_[k]); put_vec(o, prov_fy_[k]); put_vec(o, prov_tq_[k]); }
-  put(o, n_contacts_);
-  for (const auto& f : forces_) f->save(o);
-}
-
-void Simulation::load(std::istream& in) {
-  std::uint64_t magic;
-  get(in, magic);
-  if (magic != kMagic) throw std::runtime_error("not a nipdem checkpoint (bad magic)");
-  get(in, time_); get(in, step_); get(in, next_id_);
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
-                  &b_.mass, &b_.inertia, &b_.size}) get_vec(in, *v);
-  get_vec(in, b_.id); get_vec(in, b_.first_disc); get_vec(in, b_.n_discs); get_vec(in, b_.tag);
-  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
-    get_vec(in, *v);
-  get_vec(in, d_.body); get_vec(in, d_.wall_key); get_vec(in, d_.wall_eta); get_vec(in, d_.wall_slide);
-  get_vec(in, nlist_.row_start_); get_vec(in, nlist_.nbr_); get_vec(in, nlist_.eta_); get_vec(in, nlist_.slide_);
-  std::uint64_t nw;
-  get(in, nw);
-  if (nw != walls_.size()) throw std::runtime_error("checkpoint has a different number of walls than the configuration");
-  for (auto& w : walls_) get(in, w.angle);
-  std::uint64_t np;
-  get(in, np);
-  if (np != prov_fx_.size()) throw std::runtime_error("checkpoint has a different number of force providers than the configuration");
-  for (std::size_t k = 0; k < np; ++k) { get_vec(in, prov_fx_[k]); get_vec(in, prov_fy_[k]); get_vec(in, prov_tq_[k]); }
-  get(in, n_contacts_);
-  for (auto& f : forces_) f->load(in);
-  // The list is rebuilt (history carried over by identity mapping) at the next evaluation;
-  // forces of the saved state are already in the body arrays.
-  old_of_new_.resize(d_.x.size());
-  for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
-  structure_changed_ = true;
-  forces_valid_ = true;
-}
+// Simulation::save / load: engine/checkpoint.cpp
 
 }  // namespace nipdem::engine

@@ -10,6 +10,7 @@
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/io/checkpoint_file.hpp"
 #include "nipdem/geometry/walls.hpp"
 
 namespace nipdem::experiments {
@@ -307,10 +308,18 @@ void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) 
   }
 }
 
-// ---- checkpoint: runner state, then the engine's (same binary helpers as the engine) ----
+// ---- checkpoint: runner state, then the engine's, in the checksummed frame of io/checkpoint_file.hpp
+// (docs/reliability.md). Payload: "NIPDEMRUN4", resume and prefix keys, rng, counters, removals,
+// engine. Every field is written on its own (no struct padding): the bytes are a function of the
+// state, so two identical runs write identical files.
+namespace {
+constexpr char kRunTag[] = "NIPDEMRUN4";
+constexpr std::size_t kRunTagLen = 10;
+}  // namespace
+
 std::string NipRun::checkpoint() const {
   std::ostringstream o;
-  o.write("NIPDEMRUN3", 10);
+  o.write(kRunTag, kRunTagLen);
   binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.resume_key)));
   binary::put(o, static_cast<std::uint64_t>(std::hash<std::string>{}(cfg_.prefix_key)));
   for (int i = 0; i < 4; ++i) binary::put(o, rng_.state()[i]);
@@ -318,46 +327,93 @@ std::string NipRun::checkpoint() const {
   binary::put(o, inserted_roller_);
   for (auto r : removed_) binary::put(o, r);
   binary::put(o, area_debt_);
-  binary::put_vec(o, removals_);
+  binary::put(o, static_cast<std::uint64_t>(removals_.size()));
+  for (const auto& e : removals_) {
+    binary::put(o, e.time);
+    binary::put(o, static_cast<std::int32_t>(e.where));
+    binary::put(o, e.x);
+    binary::put(o, e.y);
+    binary::put(o, e.size);
+    binary::put(o, e.id);
+  }
   sim_->save(o);
-  return o.str();
+  return io::seal_checkpoint(o.str());
 }
 
 namespace {
-// Reads the header of a run checkpoint; version 2 (before 2026-12-02) has no prefix key.
-struct CheckpointHeader { std::uint64_t resume_hash = 0, prefix_hash = 0; bool has_prefix = false; };
-CheckpointHeader read_checkpoint_header(std::istream& in, const std::string& blob) {
+struct CheckpointHeader { std::uint64_t resume_hash = 0, prefix_hash = 0; };
+// Opens the frame and reads the run header; `in` is left at the runner state.
+CheckpointHeader read_checkpoint_header(std::istringstream& in, const std::string& blob, const std::string& where) {
+  const std::string_view payload = io::open_checkpoint(blob, where);
+  if (payload.substr(0, kRunTagLen) != std::string_view(kRunTag, kRunTagLen))
+    throw InputError(where + ": not a nipdem run checkpoint (payload tag is not " + kRunTag + ")");
+  in.str(std::string(payload.substr(kRunTagLen)));
   CheckpointHeader h;
-  const bool v3 = blob.compare(0, 10, "NIPDEMRUN3") == 0;
-  if (!v3 && blob.compare(0, 10, "NIPDEMRUN2") != 0) throw std::runtime_error("not a nipdem run checkpoint of this version");
-  in.ignore(10);
-  binary::get(in, h.resume_hash);
-  if (v3) {
+  try {
+    binary::get(in, h.resume_hash);
     binary::get(in, h.prefix_hash);
-    h.has_prefix = true;
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
   }
   return h;
 }
 }  // namespace
 
-void NipRun::restore(const std::string& blob) {
-  std::istringstream in(blob);
-  const auto h = read_checkpoint_header(in, blob);
+void NipRun::restore(const std::string& blob, const std::string& where) {
+  std::istringstream in;
+  const auto h = read_checkpoint_header(in, blob, where);
   if (h.resume_hash != std::hash<std::string>{}(cfg_.resume_key))
-    throw InputError("checkpoint was written with a different configuration; --resume needs the same config and --set options (only run.end_time_s and the output intervals may change)");
-  restore_state(in);
+    throw InputError(where + ": checkpoint was written with a different configuration; --resume needs the same config and --set options (only run.end_time_s and the output intervals may change)");
+  restore_state(in, where);
 }
 
-void NipRun::restore_state(std::istream& in) {
-  std::uint64_t st[4];
-  for (auto& v : st) binary::get(in, v);
-  rng_.set_state(st);
-  binary::get(in, inserted_);
-  binary::get(in, inserted_roller_);
-  for (auto& r : removed_) binary::get(in, r);
-  binary::get(in, area_debt_);
-  binary::get_vec(in, removals_);
-  sim_->load(in);
+void NipRun::restore_state(std::istream& in, const std::string& where) {
+  try {
+    auto bad = [](const std::string& what) { throw InputError("run state: " + what); };
+    std::uint64_t st[4];
+    for (auto& v : st) binary::get(in, v);
+    if ((st[0] | st[1] | st[2] | st[3]) == 0) bad("random generator state is all zero");
+    std::int64_t inserted, inserted_roller, removed[3];
+    double area_debt;
+    binary::get(in, inserted);
+    binary::get(in, inserted_roller);
+    for (auto& r : removed) binary::get(in, r);
+    binary::get(in, area_debt);
+    constexpr std::int64_t kMaxCount = std::int64_t{1} << 50;  // far above any run; their sum cannot overflow
+    for (const std::int64_t c : {inserted, inserted_roller, removed[0], removed[1], removed[2]})
+      if (c < 0 || c > kMaxCount) bad(fmt::format("a particle counter ({}) is outside [0, 2^50]", c));
+    if (!std::isfinite(area_debt)) bad(fmt::format("inflow area debt {} is not finite", area_debt));
+    std::uint64_t n;
+    binary::get(in, n);
+    const std::uint64_t total = static_cast<std::uint64_t>(removed[0] + removed[1] + removed[2]);
+    if (n != total) bad(fmt::format("{} removal events, the counters say {}", n, total));
+    std::vector<RemovalEvent> removals;
+    for (std::uint64_t k = 0; k < n; ++k) {
+      RemovalEvent e{};
+      std::int32_t where_i;
+      binary::get(in, e.time);
+      binary::get(in, where_i);
+      binary::get(in, e.x);
+      binary::get(in, e.y);
+      binary::get(in, e.size);
+      binary::get(in, e.id);
+      if (where_i < 0 || where_i > 2) bad(fmt::format("removal {}: exit {} is not developed/returned/lost", k, where_i));
+      if (!std::isfinite(e.time) || !(e.size >= 0.0) || !std::isfinite(e.size) || e.id < 0)
+        bad(fmt::format("removal {}: time, size or id out of range", k));
+      e.where = static_cast<Exit>(where_i);
+      removals.push_back(e);
+    }
+    sim_->load(in);
+    if (in.peek() != std::char_traits<char>::eof()) bad("data after the end of the state (the payload is longer than what this build writes)");
+    rng_.set_state(st);
+    inserted_ = inserted;
+    inserted_roller_ = inserted_roller;
+    for (int i = 0; i < 3; ++i) removed_[i] = removed[i];
+    area_debt_ = area_debt;
+    removals_ = std::move(removals);
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
 }
 
 double NipRun::first_print_switch_time() const {
@@ -374,12 +430,12 @@ double NipRun::first_print_switch_time() const {
   return first;
 }
 
-void NipRun::restore_before_print_switch(const std::string& blob) {
-  std::istringstream in(blob);
-  const auto h = read_checkpoint_header(in, blob);
-  if (!h.has_prefix || h.prefix_hash != std::hash<std::string>{}(cfg_.prefix_key))
-    throw InputError("prefix checkpoint was written with a configuration that differs in more than print.voltage_V");
-  restore_state(in);
+void NipRun::restore_before_print_switch(const std::string& blob, const std::string& where) {
+  std::istringstream in;
+  const auto h = read_checkpoint_header(in, blob, where);
+  if (h.prefix_hash != std::hash<std::string>{}(cfg_.prefix_key))
+    throw InputError(where + ": prefix checkpoint was written with a configuration that differs in more than print.voltage_V");
+  restore_state(in, where);
   const double t_on = first_print_switch_time();
   if (!(sim_->time() + ts_.dt <= t_on))
     throw InputError(fmt::format("prefix checkpoint at t = {:g} s is not before the drum track first switches on (t = {:g} s)", sim_->time(), t_on));

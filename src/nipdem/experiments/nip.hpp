@@ -79,15 +79,17 @@ class NipRun {
   double drum_surface_y(double x) const;    // y of the drum surface above x
   double roller_surface_y(double x) const;  // y of the base circle of the roller below x
 
-  // Checkpoint of the whole run (engine + runner state) and its restore.
+  // Checkpoint of the whole run (engine + runner state) in its checksummed frame, and its
+  // restore: every size, index and value is checked first; anything wrong throws InputError
+  // "<where>: ..." (docs/reliability.md). After a throw the run must not be used.
   std::string checkpoint() const;
-  void restore(const std::string& blob);
+  void restore(const std::string& blob, const std::string& where = "checkpoint");
   // Restores a checkpoint of a run whose configuration differs from this one at most in
   // print.voltage_V and that was taken before the drum track first switches on. Until then
   // both runs see the off voltage and take the same steps, so one prefix serves every voltage
   // of a Vo-level scan (tested bitwise against an uninterrupted run). Throws InputError if the
   // configurations differ otherwise or the checkpoint's time is not before the first switch.
-  void restore_before_print_switch(const std::string& blob);
+  void restore_before_print_switch(const std::string& blob, const std::string& where = "prefix checkpoint");
   // Time at which the drum track first switches away from its off voltage (inf: never).
   double first_print_switch_time() const;
   // Geometry and parameters for summary.json / rendering.
@@ -104,7 +106,7 @@ class NipRun {
   bool place(engine::BodySpec spec, Vec2 pos, double angle, Vec2 velocity, double omega);
   void prefill();
   // The checkpoint after its header (rng, counters, removals, engine).
-  void restore_state(std::istream& in);
+  void restore_state(std::istream& in, const std::string& where);
   // Fills the pits of the whole window (start) or the pit(s) that entered through x_min
   // during the last inflow pass; returns the count.
   int fill_pits_entering(bool whole_window);

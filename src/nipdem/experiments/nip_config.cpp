@@ -1,5 +1,8 @@
 #include "nipdem/experiments/nip_config.hpp"
 
+#include <cstdio>
+#include <unistd.h>
+
 #include <cmath>
 #include <sstream>
 
@@ -64,6 +67,10 @@ toml::table resolve_nip_table(const std::string& text, const std::string& file, 
   toml::table user;
   return resolve(text, file, overrides, user);
 }
+
+namespace {
+void check_resource_bounds(const NipConfig& c, const TimeStep& ts);
+}  // namespace
 
 NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
   toml::table user;
@@ -279,7 +286,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   std::ostringstream pk;
   pk << root;
   c.prefix_key = pk.str();
-  choose_time_step(c);  // refuses a time step above the stability bound
+  check_resource_bounds(c, choose_time_step(c));  // refuses a time step above the stability bound
   return c;
 }
 
@@ -370,6 +377,12 @@ TimeStep choose_time_step(const NipConfig& c) {
     if (bound < ts.bound) { ts.bound = bound; ts.limiting = ia[i].name; }
   }
   ts.dt = c.dt > 0.0 ? c.dt : c.dt_fraction * tmin;
+  // A step far below the contact time resolves nothing more and never ends (issue 21): the same
+  // lower limit as run.dt_fraction_of_contact_time.
+  if (c.dt > 0.0 && c.dt < 1e-4 * tmin)
+    throw_input(c.file, "run.dt_s", fmt::format("{:g}", c.dt),
+                fmt::format("time step below 1e-4 of the shortest contact time ({:.3g} s): the run would take forever", tmin),
+                fmt::format("[{:.4g}, {:.4g}] s", 1e-4 * tmin, ts.bound));
   if (ts.dt > ts.bound)
     throw_input(c.file, c.dt > 0.0 ? "run.dt_s" : "run.dt_fraction_of_contact_time", fmt::format("{:g}", c.dt > 0 ? c.dt : c.dt_fraction),
                 fmt::format("time step {:.3g} s exceeds the stability bound of the {} integrator, set by the {} contact "
@@ -379,5 +392,41 @@ TimeStep choose_time_step(const NipConfig& c) {
                 fmt::format("dt_s <= {:.4g}", ts.bound));
   return ts;
 }
+
+namespace {
+// Bounds for what a run may cost (issue 21, docs/reliability.md): at least one step, output and
+// checkpoint intervals not below the step, and the particles the window can hold within the
+// machine's memory, all refused before anything is allocated.
+void check_resource_bounds(const NipConfig& c, const TimeStep& ts) {
+  const std::string range_dt = fmt::format("[dt = {:.4g} s, 10 s]", ts.dt);
+  if (c.end_time < ts.dt)
+    throw_input(c.file, "run.end_time_s", fmt::format("{:g}", c.end_time), "end time below one time step: nothing would run", range_dt);
+  if (c.output_interval < ts.dt)
+    throw_input(c.file, "run.output_interval_s", fmt::format("{:g}", c.output_interval), "output interval below the time step", range_dt);
+  if (c.checkpoint_interval < ts.dt)
+    throw_input(c.file, "run.checkpoint_interval_s", fmt::format("{:g}", c.checkpoint_interval), "checkpoint interval below the time step", range_dt);
+  // Upper bound of the particle count: the window between the two surfaces (their sag at the
+  // window's ends and the pits included) filled with the smallest particles at 90 % area fraction.
+  const double w = std::max(std::fabs(c.x_min - c.nip_x), std::fabs(c.x_max - c.nip_x));
+  const double height = c.gap + (c.roughness ? c.rough_height : 0.0) + w * w / (2.0 * c.drum_radius) + w * w / (2.0 * c.roller_radius);
+  const double dmin = c.size.d_min();
+  const double n_max = 0.9 * (c.x_max - c.x_min) * height / (pi * dmin * dmin / 4.0);
+  constexpr double kBytesPerParticle = 4096.0;  // bodies, their discs, histories, lists, output (measured ~2 kB)
+  const double bytes = n_max * kBytesPerParticle;
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+  const double ram = pages > 0 && page > 0 ? static_cast<double>(pages) * static_cast<double>(page) : 64.0 * (1ull << 30);
+  if (bytes > ram)
+    throw_input(c.file, "geometry.window_x_min_m, geometry.window_x_max_m, geometry.gap_m",
+                fmt::format("window [{:g}, {:g}] m, gap {:g} m", c.x_min, c.x_max, c.gap),
+                fmt::format("the window can hold up to {:.3g} particles of d = {:.3g} m, about {:.3g} GiB, more than this "
+                            "machine's memory ({:.3g} GiB)", n_max, dmin, bytes / (1ull << 30), ram / (1ull << 30)),
+                fmt::format("a window holding at most {:.3g} particles", ram / kBytesPerParticle));
+  // Output volume: a warning (the user may mean it), with the numbers.
+  const double frames = c.end_time / c.output_interval;
+  if (c.vtk && frames * n_max * 200.0 > 50.0 * (1ull << 30))
+    std::fprintf(stderr, "nipdem: warning: %s: run.output_interval_s = %g gives %.3g frames of up to %.3g particles: up to %.3g GiB of "
+                         "particle output\n", c.file.c_str(), c.output_interval, frames, n_max, frames * n_max * 200.0 / (1ull << 30));
+}
+}  // namespace
 
 }  // namespace nipdem::experiments

@@ -130,6 +130,8 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
   if (f.gaps_m.empty()) throw_input("experiment front-position", "--gap", "", "need at least one gap");
   for (double g : f.gaps_m) require_range("experiment front-position", "--gap", g, 20e-6, 5e-3);
   for (double v : f.sleeve_speeds_m_per_min) require_range("experiment front-position", "--sleeve-speed", v, 0.0, 1000.0);
+  require_range("experiment front-position", "--min-time", f.min_time_s, 0.0, 10.0);
+  require_range("experiment front-position", "--max-time", f.max_time_s, 1e-6, 10.0);
   if (!(f.max_time_s >= f.min_time_s)) throw_input("experiment front-position", "--max-time", num(f.max_time_s), "must not be below --min-time", fmt::format("[{:g}, inf)", f.min_time_s));
   std::vector<std::pair<double, double>> points;  // (gap, speed m/s; <0 = preset)
   const std::vector<double> speeds = f.sleeve_speeds_m_per_min.empty() ? std::vector<double>{-1.0} : f.sleeve_speeds_m_per_min;
@@ -238,6 +240,8 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   if (r.cohesion_ratios.empty()) throw_input("experiment reduction", "--r", "", "need at least one cohesion ratio");
   for (double v : r.cohesion_ratios) require_range("experiment reduction", "--r", v, 0.0, 1e6);
   require_range("experiment reduction", "--time", r.time_s, 1e-6, 10.0);
+  require_range("experiment reduction", "--pile-width", r.pile_width_m, 10e-6, 2.0 * r.window_half_width_m);
+  require_range("experiment reduction", "--pile-height", r.pile_height_m, 10e-6, 4e-3);
   if (r.pits != "empty" && r.pits != "filled" && r.pits != "preset")
     throw_input("experiment reduction", "--pits", r.pits, "allowed: empty, filled, preset");
   auto point_sets = [&](std::size_t i) {
@@ -385,9 +389,19 @@ std::optional<std::string> print_prefix(const ExperimentOptions& o, const PrintO
 }
 }  // namespace
 
+namespace {
+// The printed line's options, checked before any run (a NaN would print nothing and "succeed").
+void check_print_options(const std::string& where, const PrintOptions& p) {
+  require_range(where, "--line-length (print.length_m)", p.line_length_m, 1e-6, 1.0);
+  require_range(where, "--line-start (print.start_m)", p.line_start_m, -1.0, 1.0);
+  require_range(where, "--extra-time", p.extra_time_s, 0.0, 1.0);
+}
+}  // namespace
+
 json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   require_range("experiment vo-level", "--step", v.step_V, 1e-3, 100.0);
-  if (v.seeds < 1) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "need >= 1");
+  if (v.seeds < 1 || v.seeds > 100000) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "out of range", "[1, 100000]");
+  check_print_options("experiment vo-level", v.print);
   // the search options are checked once here (exit 2), not in every seed's task
   analysis::find_vo_level([](double) { return 1L; }, {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V});
   // reject a bad configuration or line before any run starts (exit 2, not failed points)
@@ -425,7 +439,11 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
 }
 
 json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
-  if (e.realizations < 2) throw_input("experiment edge-sharpness", "--realizations", std::to_string(e.realizations), "need >= 2");
+  if (e.realizations < 2 || e.realizations > 100000)
+    throw_input("experiment edge-sharpness", "--realizations", std::to_string(e.realizations), "out of range", "[2, 100000]");
+  if (e.bootstrap < 0 || e.bootstrap > 1000000)
+    throw_input("experiment edge-sharpness", "--bootstrap", std::to_string(e.bootstrap), "out of range", "[0, 1000000]");
+  check_print_options("experiment edge-sharpness", e.print);
   // The line is printed at the configuration's print.voltage_V (default 40 V, §5.3).
   std::vector<std::string> fixed;
   for (const auto& f : print_sets(e.print, 0.0, 0))

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <unordered_map>
 
@@ -130,15 +131,26 @@ void MagnetForce::field_pass(const BodyStore& b) {
   // Tiles are built serially first; the parallel loop only reads them. Each particle is
   // independent, so the result does not depend on the thread count.
   for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
+  // No exception may leave an OpenMP region (it would end the program): a failure (e.g. a field
+  // map asked outside its range, InputError) is caught per particle and the one of the lowest
+  // index rethrown after the loop, so any thread count reports the same error as one thread.
+  std::size_t first_bad = n;
+  std::exception_ptr error;
 #pragma omp parallel for schedule(static) num_threads(nt)
   for (std::size_t i = 0; i < n; ++i) {
-    const Vec2 p{b.x[i], b.y[i]};
-    const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
-    moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
-    const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
-    ffx_[i] = f.x;
-    ffy_[i] = f.y;
+    try {
+      const Vec2 p{b.x[i], b.y[i]};
+      const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
+      moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
+      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
+      ffx_[i] = f.x;
+      ffy_[i] = f.y;
+    } catch (...) {
+#pragma omp critical(nipdem_magnet_field_pass_error)
+      if (i < first_bad) { first_bad = i; error = std::current_exception(); }
+    }
   }
+  if (error) std::rethrow_exception(error);
 }
 
 // Dipole-dipole forces (eqs. 2.4.38-2.4.39) between the induced moments within the cut-off:
@@ -162,8 +174,39 @@ using binary::put_vec;
 void MagnetForce::save(std::ostream& o) const {
   put(o, calls_); put_vec(o, ids_); put_vec(o, ffx_); put_vec(o, ffy_); put_vec(o, dfx_); put_vec(o, dfy_); put_vec(o, moment_);
 }
+namespace {
+[[noreturn]] void bad_state(const char* provider, const std::string& what) {
+  throw InputError(fmt::format("{} force state: {}", provider, what));
+}
+template <class T> void require_len(const char* provider, const std::vector<T>& v, std::size_t n, const char* name) {
+  if (v.size() != n) bad_state(provider, fmt::format("{} has {} entries, expected {}", name, v.size(), n));
+}
+void require_finite_all(const char* provider, const std::vector<double>& v, const char* name) {
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v[i])) bad_state(provider, fmt::format("{}[{}] = {} is not finite", name, i, v[i]));
+}
+}  // namespace
+
+// Everything read is checked before use (docs/reliability.md): the held forces are indexed by
+// body in add() whenever the ids match, so their sizes must match the ids they belong to.
 void MagnetForce::load(std::istream& in) {
-  get(in, calls_); get_vec(in, ids_); get_vec(in, ffx_); get_vec(in, ffy_); get_vec(in, dfx_); get_vec(in, dfy_); get_vec(in, moment_);
+  get(in, calls_); get_vec(in, ids_, "magnet ids"); get_vec(in, ffx_, "magnet fx"); get_vec(in, ffy_, "magnet fy");
+  get_vec(in, dfx_, "dipole fx"); get_vec(in, dfy_, "dipole fy"); get_vec(in, moment_, "magnet moments");
+  const char* who = "magnetic";
+  if (calls_ < 0) bad_state(who, fmt::format("call count {} < 0", calls_));
+  const std::size_t n = ids_.size();
+  require_len(who, ffx_, n, "field force x");
+  require_len(who, ffy_, n, "field force y");
+  require_len(who, moment_, n, "moments");
+  if (cfg_.dipole_dipole || !dfx_.empty() || !dfy_.empty()) {
+    require_len(who, dfx_, n, "dipole force x");
+    require_len(who, dfy_, n, "dipole force y");
+  }
+  for (auto* v : {&ffx_, &ffy_, &dfx_, &dfy_}) require_finite_all(who, *v, "a held force");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(moment_[i].x) || !std::isfinite(moment_[i].y)) bad_state(who, fmt::format("moment[{}] is not finite", i));
+    if (i > 0 && ids_[i] <= ids_[i - 1]) bad_state(who, fmt::format("body ids are not increasing at {}", i));
+  }
   pairs_.invalidate();  // the list is a cache: rebuilt at the next pass, same forces (see PairSum)
 }
 
@@ -174,8 +217,40 @@ void ElectricForce::save(std::ostream& o) const {
 }
 void ElectricForce::load(std::istream& in) {
   get(in, calls_); get(in, t_last_); get(in, v_drum_); get(in, n_printable_);
-  get_vec(in, u_); get_vec(in, ids_); get_vec(in, coupling_); get_vec(in, printable_); get_vec(in, near_disc_);
-  get_vec(in, gap_); get_vec(in, r_path_);
+  get_vec(in, u_, "voltages"); get_vec(in, ids_, "electric ids"); get_vec(in, coupling_, "couplings");
+  get_vec(in, printable_, "printable flags"); get_vec(in, near_disc_, "nearest discs"); get_vec(in, gap_, "gaps");
+  get_vec(in, r_path_, "path resistances");
+  const char* who = "electric";
+  if (calls_ < 0) bad_state(who, fmt::format("call count {} < 0", calls_));
+  if (!std::isfinite(t_last_) || !std::isfinite(v_drum_)) bad_state(who, "last time or drum voltage not finite");
+  require_len(who, u_, ids_.size(), "voltages");
+  require_finite_all(who, u_, "voltage");
+  for (std::size_t i = 1; i < ids_.size(); ++i)
+    if (ids_[i] <= ids_[i - 1]) bad_state(who, fmt::format("body ids are not increasing at {}", i));
+  // The per-body refresh data (all sized at the last refresh) are used without a refresh only if
+  // they match the engine's body count; their disc indices must then be the engine's discs.
+  const std::size_t nr = coupling_.size();
+  require_len(who, printable_, nr, "printable flags");
+  require_len(who, near_disc_, nr, "nearest discs");
+  require_len(who, gap_, nr, "gaps");
+  require_len(who, r_path_, nr, "path resistances");
+  const auto& b = sim_->bodies();
+  const auto& d = sim_->discs();
+  int printable = 0;
+  for (std::size_t i = 0; i < nr; ++i) {
+    const int c = static_cast<int>(coupling_[i]);
+    if (c < 0 || c > 2) bad_state(who, fmt::format("coupling[{}] = {} is not none/capacitor/contact", i, c));
+    if (printable_[i] != 0 && printable_[i] != 1) bad_state(who, fmt::format("printable[{}] is not 0 or 1", i));
+    if (printable_[i] && coupling_[i] == charge::DrumCoupling::none) bad_state(who, fmt::format("body {} printable without coupling", i));
+    printable += printable_[i];
+    if (std::isnan(gap_[i]) || std::isnan(r_path_[i]) || !(r_path_[i] > 0.0))
+      bad_state(who, fmt::format("gap or path resistance of body {} is not a number (> 0 for the resistance)", i));
+    const int k = near_disc_[i];
+    const bool used = nr == b.x.size() && coupling_[i] != charge::DrumCoupling::none;
+    if (k < -1 || (used && (k < 0 || static_cast<std::size_t>(k) >= d.x.size() || d.body[k] != static_cast<int>(i))))
+      bad_state(who, fmt::format("nearest disc {} of body {} is not one of its discs", k, i));
+  }
+  if (printable != n_printable_) bad_state(who, fmt::format("{} printable bodies, the count says {}", printable, n_printable_));
   paths_.resize(0);  // rebuilt from the contacts at the next refresh (exact, same distances)
 }
 

@@ -1,6 +1,9 @@
 #include "nipdem/experiments/run_driver.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -23,41 +26,98 @@ std::string removals_csv(const NipRun& run) {
     s += fmt::format("{:.9g},{},{:.9g},{:.9g},{:.6g},{}\n", e.time, exit_name(e.where), e.x, e.y, e.size, e.id);
   return s;
 }
+// Temp files "<name>.tmp.<pid>" of a writer that no longer runs (killed between the write and
+// the rename of write_file_atomic): removed, so a killed run leaves nothing behind after the next.
+void remove_stale_temp_files(const fs::path& out) {
+  for (const fs::path& dir : {out, out / "particles"}) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) continue;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      const auto at = name.rfind(".tmp.");
+      if (at == std::string::npos || !e.is_regular_file(ec)) continue;
+      const std::string pid = name.substr(at + 5);
+      if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+      if (std::stol(pid) == static_cast<long>(::getpid()) || fs::exists("/proc/" + pid, ec)) continue;  // a live writer
+      fs::remove(e.path(), ec);
+    }
+  }
+}
 }  // namespace
 
-json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt) {
-  fs::create_directories(out);
+json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in) {
+  RunOptions opt = opt_in;
+  if (fs::exists(out) && !fs::is_directory(out)) throw InputError(out.string() + ": --out names a file, not a folder");
+  {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) throw InputError(out.string() + ": --out folder cannot be created (" + ec.message() + ")");
+  }
+  remove_stale_temp_files(out);
   const fs::path ckpt = out / "checkpoint.bin";
+  // A run killed before its first checkpoint has nothing worth keeping: --resume starts it
+  // again from t = 0, and so does a plain run (issue 21). Results (a summary or a checkpoint)
+  // are never overwritten without --force.
+  const bool has_results = fs::exists(out / "summary.json") || fs::exists(ckpt);
   if (opt.resume) {
-    if (!fs::exists(ckpt)) throw InputError(ckpt.string() + ": no checkpoint to resume from");
-  } else if (!opt.force && (fs::exists(out / "summary.json") || fs::exists(ckpt) || fs::exists(out / "particles.pvd"))) {
+    if (!fs::exists(ckpt)) {
+      if (fs::exists(out / "summary.json"))
+        throw InputError(ckpt.string() + ": no checkpoint to resume from, but the folder holds a finished run's summary.json");
+      std::fprintf(stderr, "nipdem run: %s: no checkpoint yet (the run stopped before its first one): starting from t = 0\n",
+                   out.string().c_str());
+      opt.resume = false;
+    }
+  } else if (!opt.force && has_results) {
     throw InputError(out.string() + ": already holds results of a run; use --resume to continue it, --force to overwrite, or another --out");
   }
   NipRun run(cfg);
   std::vector<std::pair<double, std::string>> frames;
   std::string series = "time_s,bodies,discs,inserted,developed,returned,lost,contacts,kinetic_energy_J,drum_voltage_V,printable,charged_over_1V,max_voltage_V\n";
+  const double dt = run.time_step().dt;
   if (opt.resume) {
-    run.restore(io::read_file(ckpt));
+    run.restore(io::read_file(ckpt, io::kMaxCheckpointBytes), ckpt.string());
+    // An end time before the checkpoint is an error; one at the checkpoint's time only finishes
+    // the outputs of a run killed after its last checkpoint (no summary yet), else nothing is left.
+    const double tc = run.sim().time();
+    if (cfg.end_time < tc - 0.5 * dt || (cfg.end_time < tc + 0.5 * dt && fs::exists(out / "summary.json")))
+      throw_input(cfg.file, "run.end_time_s", fmt::format("{:g}", cfg.end_time),
+                  fmt::format("the checkpoint {} is at t = {:g} s{}: nothing left to run", ckpt.string(), tc,
+                              cfg.end_time < tc - 0.5 * dt ? "" : " and the run's summary.json exists"),
+                  fmt::format("> {:g} s (the checkpoint's time plus half a step)", tc + 0.5 * dt));
     if (fs::exists(out / "frames.json")) {
-      for (auto& f : json::parse(io::read_file(out / "frames.json"))) frames.emplace_back(f[0].get<double>(), f[1].get<std::string>());
+      const fs::path fj = out / "frames.json";
+      try {
+        for (auto& f : json::parse(io::read_file(fj))) frames.emplace_back(f.at(0).get<double>(), f.at(1).get<std::string>());
+      } catch (const json::exception& e) {
+        throw InputError(fj.string() + ": not a frame list of a nipdem run (" + e.what() + ")");
+      }
     }
     if (fs::exists(out / "timeseries.csv")) series = io::read_file(out / "timeseries.csv");
-    // drop snapshots written after the checkpoint (they will be written again)
-    while (!frames.empty() && frames.back().first > run.sim().time() + 1e-15) frames.pop_back();
+    // Drop snapshots and rows written after the checkpoint (they will be written again). Rows
+    // carry time to 9 digits, so "after" means more than half a step later: the row at the
+    // checkpoint's own time is kept whichever way its printed time rounded.
+    const double t_keep = run.sim().time() + 0.5 * dt;
+    while (!frames.empty() && frames.back().first > t_keep) frames.pop_back();
     std::string kept;
     std::size_t pos = 0;
     int line = 0;
     while (pos < series.size()) {
       const auto nl = series.find('\n', pos);
       const std::string row = series.substr(pos, nl - pos + 1);
-      if (line++ == 0 || std::stod(row.substr(0, row.find(','))) <= run.sim().time() + 1e-15) kept += row;
+      if (line++ > 0) {
+        char* end = nullptr;
+        const double t_row = std::strtod(row.c_str(), &end);
+        if (end == row.c_str() || *end != ',' || !std::isfinite(t_row))
+          throw InputError(fmt::format("{}:{}: row does not start with a time (damaged file?)", (out / "timeseries.csv").string(), line));
+        if (t_row > t_keep) break;  // rows are in time order
+      }
+      kept += row;
       pos = nl == std::string::npos ? series.size() : nl + 1;
     }
     series = kept;
   }
   io::write_file_atomic(out / "config.toml", cfg.resolved_toml);
 
-  const double dt = run.time_step().dt;
   auto snapshot = [&] {
     auto& sim = run.sim();
     if (cfg.vtk) {

@@ -1,5 +1,6 @@
 // Never lose results already written: write to "<path>.tmp.<pid>" then rename over <path>.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -10,7 +11,14 @@ namespace nipdem::io {
 // Throws std::runtime_error naming the path on failure; the old file is left untouched.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
-// Reads a whole file; throws InputError naming the path if it cannot be read.
-std::string read_file(const std::filesystem::path& path);
+// Largest input file (config, CSV, map, pattern, JSON) nipdem reads [bytes]: far above any real
+// one, small enough that a wrong path (a disk image, a log) is refused before it is read.
+inline constexpr std::uintmax_t kMaxInputBytes = 256ull << 20;
+// Largest checkpoint [bytes] (about 10^7 particles).
+inline constexpr std::uintmax_t kMaxCheckpointBytes = 16ull << 30;
+
+// Reads a whole file; throws InputError naming the path if it is not a regular file (a folder,
+// a device such as /dev/zero, a FIFO), is larger than max_bytes, or cannot be read.
+std::string read_file(const std::filesystem::path& path, std::uintmax_t max_bytes = kMaxInputBytes);
 
 }  // namespace nipdem::io

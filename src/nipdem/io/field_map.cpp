@@ -227,6 +227,12 @@ FieldMap FieldMap::from_csv(std::string_view text, const std::string& where) {
   const int nx = static_cast<int>(ux.size()), ny = static_cast<int>(uy.size());
   const double hx = (ux.back() - ux.front()) / (nx - 1), hy = (uy.back() - uy.front()) / (ny - 1);
   const std::size_t n = static_cast<std::size_t>(nx) * ny;
+  // Every node exactly once means as many rows as nodes: checked before the grid is allocated,
+  // so scattered points (nx, ny ~ rows) cannot make a small file ask for rows^2 values.
+  if (xs.size() != n)
+    throw_input(where, "rows", fmt::format("{} rows for {} x {} = {} grid nodes", xs.size(), nx, ny, n),
+                xs.size() < n ? "ragged grid: nodes are missing" : "grid nodes given twice",
+                "every node of the nx x ny grid exactly once");
   std::vector<double> Bx(n, 0.0), By(n, 0.0);
   std::vector<char> seen(n, 0);
   for (std::size_t r = 0; r < xs.size(); ++r) {

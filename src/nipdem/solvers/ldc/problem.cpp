@@ -27,8 +27,15 @@ void validate(const Params& p) {
   if (!(p.y_max_m > p.y_min_m))
     throw_input(where, "y_max_m", fmt::format("{}", p.y_max_m), "box has zero or negative height",
                 fmt::format("> y_min_m = {}", p.y_min_m));
-  if (p.cells_x < 2) throw_input(where, "cells_x", std::to_string(p.cells_x), "coarse grid too small", ">= 2");
-  if (p.cells_y < 2) throw_input(where, "cells_y", std::to_string(p.cells_y), "coarse grid too small", ">= 2");
+  for (double v : {p.x_min_m, p.x_max_m, p.y_min_m, p.y_max_m})
+    if (!std::isfinite(v)) throw_input(where, "box", fmt::format("{}", v), "box corner not finite", "finite coordinates [m]");
+  // Upper bounds keep every node count within int and the factorisation within memory (the
+  // grids used are <= 320 x 320 nodes; 2048^2 cells ~ 4e6 nodes, ~1 GB of factor).
+  constexpr int kMaxCells = 2048;
+  if (p.cells_x < 2 || p.cells_x > kMaxCells)
+    throw_input(where, "cells_x", std::to_string(p.cells_x), "coarse grid size out of range", "[2, 2048]");
+  if (p.cells_y < 2 || p.cells_y > kMaxCells)
+    throw_input(where, "cells_y", std::to_string(p.cells_y), "coarse grid size out of range", "[2, 2048]");
   const double ratio = p.hx() / p.hy();
   if (ratio > 4.0 || ratio < 0.25)
     throw_input(where, "cells_x/cells_y", fmt::format("hx/hy = {}", ratio), "coarse cells too elongated",
