@@ -92,9 +92,10 @@ engine::Simulation filled_engine() {
 // Element sizes of the engine's vectors in save order (checkpoint.cpp): 12 body doubles, id,
 // first_disc, n_discs, tag, 12 disc doubles, body, wall_key, wall_eta, wall_slide, row_start,
 // nbr, eta, slide.
-constexpr int kElem[] = {8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4, 4, 4, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4, 8, 8, 1, 4, 4, 8, 1};
-enum Vec { kBodyX = 0, kBodyMass = 9, kBodyId = 12, kFirstDisc = 13, kNDiscs = 14, kDiscX = 16, kDiscR = 22, kDiscBody = 28,
-           kWallKey = 29, kRowStart = 32, kNbr = 33 };
+constexpr int kElem[] = {8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4, 4, 4, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 8, 4, 8, 8, 1, 4, 4, 8, 1};
+// body x, y, vx, vy, theta, omega, cos theta, sin theta, fx, fy, torque, mass, inertia, size; id, ...
+enum Vec { kBodyX = 0, kBodyCos = 6, kBodyMass = 11, kBodyId = 14, kFirstDisc = 15, kNDiscs = 16, kDiscX = 18, kDiscR = 24,
+           kDiscBody = 30, kWallKey = 31, kRowStart = 34, kNbr = 35 };
 // Offset of the count of vector v in an engine blob.
 std::size_t vec_offset(const std::string& s, int v) {
   std::size_t at = 32;  // magic, time, step, next_id
@@ -140,6 +141,7 @@ TEST(EngineCheckpoint, EveryInconsistentCountOrIndexIsRefused) {
       {"body id duplicated", [](std::string& s) { poke<std::int64_t>(s, kBodyId, 1, 0); }, "body id[1]"},
       {"mass negative", [](std::string& s) { poke<double>(s, kBodyMass, 2, -1.0); }, "body mass[2]"},
       {"position NaN", [&](std::string& s) { poke<double>(s, kBodyX, 3, nan); }, "body x[3]"},
+      {"orientation not a unit vector", [](std::string& s) { poke<double>(s, kBodyCos, 2, 0.5); }, "body orientation 2"},
       {"disc position inf", [&](std::string& s) { poke<double>(s, kDiscX, 0, INFINITY); }, "disc x[0]"},
       {"radius zero", [](std::string& s) { poke<double>(s, kDiscR, 4, 0.0); }, "disc r[4]"},
       {"wall key names no wall", [](std::string& s) { poke<std::int64_t>(s, kWallKey, 0, std::int64_t{3} << 40); }, "wall_key[0]"},
