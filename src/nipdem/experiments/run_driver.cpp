@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/core/wait_policy.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/progress.hpp"
 #include "nipdem/io/vtk.hpp"
@@ -198,6 +199,7 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
       {"dt_limited_by", run.time_step().limiting},
       {"integrator", cfg.integrator == engine::Integrator::velocity_verlet ? "velocity_verlet" : "newmark_explicit"},
       {"threads", cfg.threads},
+      {"omp_waits", wait_policy()},  // how OpenMP threads waited (core/wait_policy.hpp)
       {"particles_in_window", run.sim().bodies().x.size()},
       {"discs_in_window", run.sim().discs().x.size()},
       {"inserted", run.inserted()},
