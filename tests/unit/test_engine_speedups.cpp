@@ -10,6 +10,14 @@
 #include <utility>
 #include <vector>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "../cli_run.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
@@ -184,4 +192,25 @@ TEST(WallCandidates, AWallMovedBetweenListBuildsIsFeltAtOnce) {
   sim.compute_forces();
   EXPECT_EQ(sim.contacts(), 1);
   EXPECT_NEAR(sim.bodies().fy[0], 56 * 1e-6, 1e-3 * 56e-6);  // k * overlap, disc at rest
+}
+
+// The program chooses its OpenMP wait policy (core/wait_policy.hpp): with no policy in the
+// environment a run records passive waits; a user's own setting wins.
+TEST(WaitPolicy, TheCliSetsPassiveWaitsUnlessTheUserChose) {
+  const std::string out = "/tmp/nipdem_waits_" + std::to_string(::getpid());
+  const std::string args = std::string(" run ") + NIPDEM_SOURCE_DIR + "/examples/nip_black_small.toml --set run.end_time_s=2e-6 --force --out ";
+  auto waits = [&](const std::string& env, const std::string& dir) {
+    const auto r = nipdem::test::run_cli_command("env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT " + env + " " + NIPDEM_CLI_PATH + args + dir, "waits");
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::ifstream f(dir + "/summary.json");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    const std::string s = ss.str();
+    const auto k = s.find("\"omp_waits\"");
+    return k == std::string::npos ? std::string("(missing)") : s.substr(k, s.find('\n', k) - k);
+  };
+  EXPECT_NE(waits("", out + "_a").find("OMP_WAIT_POLICY=passive"), std::string::npos);
+  EXPECT_NE(waits("OMP_WAIT_POLICY=active", out + "_b").find("OMP_WAIT_POLICY=active"), std::string::npos);
+  std::filesystem::remove_all(out + "_a");
+  std::filesystem::remove_all(out + "_b");
 }
