@@ -121,9 +121,11 @@ TEST(FieldTable, SmoothInKnowsTheFaces) {
 // Beyond |x| = 2.71 mm the knife's flat return magnet lies above the roller surface less the
 // 15 um pits: a window reaching there is refused naming the window keys and the valid region
 // (the 2.83 mm where the flat top leaves the 2 cm roller, less the pit depth: x^2 / 2R = 185 um).
+// The pit depth is pinned to 15 um (the presets use the 7.1 um equal-volume cut since issue 17).
 TEST(FieldTable, WindowReachingIntoTheMagnetIsRefusedAtSetup) {
   const auto c = parse_nip_config(preset_text("black"), "preset:black",
-                                  {"geometry.window_x_min_m=-4.2e-3", "geometry.window_x_max_m=4.2e-3", "output.vtk=false"});
+                                  {"geometry.window_x_min_m=-4.2e-3", "geometry.window_x_max_m=4.2e-3", "output.vtk=false",
+                                   "geometry.roughness.height_m=15e-6"});
   const std::string m = refusal(c);
   ASSERT_FALSE(m.empty());
   EXPECT_NE(m.find("geometry.window_x_max_m"), std::string::npos) << m;
