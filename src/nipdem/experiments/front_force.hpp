@@ -21,7 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/experiments/experiment.hpp"
 
 namespace nipdem::experiments {
 

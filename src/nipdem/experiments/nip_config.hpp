@@ -6,8 +6,14 @@
 // them without a config; tests/unit/test_nip_config.cpp checks those equal the black preset.
 // Every key carries its unit; the loader rejects unknown keys and out-of-range values with a
 // message naming file, key, value and the allowed range.
+//
+// The typed fields are the configuration. Code that varies it (the experiments) edits the
+// fields of a copy and calls validate(), which checks what depends on more than one key and
+// regenerates the resolved table and the resume keys from the fields: no `key=value` strings,
+// no second reading of the file.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,12 +96,24 @@ struct NipConfig {
   Vec2 gravity;
   // [magnet]
   MagnetConfig magnet;
+  std::string magnet_pigment;        // "black" | "color": the base of magnet.toner
   // [electric] and [print]
   ElectricConfig electric;
+  std::string charge_preset;         // "black" | "color": the base of electric.rc
+  // [print] as given: the small pattern language of io/print_pattern.hpp; validate() compiles
+  // it into electric.pattern. print_given: the file (or an experiment) gave a [print] table
+  // (the preset's pattern = "none" does not count: [electric] enabled needs one).
+  toml::table print;
+  bool print_given{};
   // [output]
   bool vtk{};
 
   std::vector<ClusterTemplate> templates;  // resolved library
+  // The merged table as read: only its layout and number kinds (an integer written as `40`
+  // stays `40`) are used; validate() writes every field into it, so a configuration read from a
+  // file serializes exactly as written, and a default-constructed one still lists every key.
+  toml::table table;
+  // Set by validate():
   std::string resolved_toml;               // the complete resolved configuration (run folder's config.toml):
                                            // preset + file + --set, with derived values recorded
   std::string resume_key;                  // the configuration minus keys a resume may change
@@ -104,12 +122,24 @@ struct NipConfig {
   std::string prefix_key;
 };
 
-// Loads and validates. `overrides` are KEY=VALUE strings (from --set).
 // The preset named by the file's `preset` key (default "black") merged with the file and the
-// overrides (not yet validated).
+// overrides (not yet validated). `overrides` are KEY=VALUE strings (the user's --set).
 toml::table resolve_nip_table(const std::string& text, const std::string& file, const std::vector<std::string>& overrides = {});
+// Reads preset + file + overrides into the typed fields, checking every key on its own (type,
+// range, unknown keys); not yet validated.
+NipConfig read_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides = {});
+// The one check of a whole configuration, after reading or after editing fields: cross-checks
+// (gap vs particle size, window vs radii, initial assembly inside the window, [electric] needs
+// a [print]), the [print] pattern compiled, values that follow from other fields (the drum
+// geometry the electric force sees), the time step against its stability bound, resource
+// bounds; then resolved_toml, resume_key and prefix_key from the fields. Throws InputError.
+void validate(NipConfig& c);
+// read + validate.
 NipConfig load_nip_config(const std::string& path, const std::vector<std::string>& overrides = {});
 NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides = {});
+// Prints one line: [electric] on, [print] pattern = "line" from start_m over length_m, at
+// voltage_V if given (else the table's own voltage_V). Other [print] keys are kept.
+void set_print_line(NipConfig& c, double start_m, double length_m, std::optional<double> voltage_V = std::nullopt);
 
 // Derived collision parameters of one type for reporting (d50 particles).
 struct CollisionReport {
