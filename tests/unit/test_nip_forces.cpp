@@ -101,7 +101,7 @@ TEST(NipMagnetForce, ThreadedDipolePassEqualsSerial) {
 TEST(NipMagnetForce, AMapAskedOutsideItsRangeFailsCleanlyOnAnyThreadCount) {
   // A failure inside the threaded field pass (here: a body outside the field map) must come out
   // of the OpenMP region as the same InputError as with one thread, never std::terminate.
-  auto field = std::make_shared<io::FieldMap>(io::FieldMap::sample(magnet::preset_field("black"), -200e-6, 200e-6, 41, 0.0, 200e-6, 21));
+  auto field = std::make_shared<io::FieldMap>(io::FieldMap::sample(magnet::make_knife(), -200e-6, 200e-6, 41, 0.0, 200e-6, 21));
   BodyStore b = bodies(64, 9);
   b.x[40] = 500e-6;  // outside the map
   b.x[50] = -600e-6;
