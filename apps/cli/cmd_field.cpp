@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/field_map.hpp"

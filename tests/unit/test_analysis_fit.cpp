@@ -7,7 +7,7 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 
 using namespace nipdem;
 using namespace nipdem::analysis;
@@ -210,7 +210,7 @@ TEST(AnalysisSigmoid, BadInputIsAnInputError) {
 
 #include <filesystem>
 
-#include "nipdem/experiments/analysis_report.hpp"
+#include "nipdem/analysis/report.hpp"
 #include "nipdem/io/csv.hpp"
 
 TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {

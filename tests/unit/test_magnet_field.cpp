@@ -7,7 +7,7 @@
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/models/magnet_field.hpp"
 
 using namespace nipdem;

@@ -13,8 +13,8 @@
 
 #include "../cli_run.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/models/hamaker.hpp"

@@ -1,4 +1,4 @@
-// The magnet force provider of the nip (experiments/nip_forces): per-body force equals the
+// The magnet force provider of the nip (nip/nip_forces): per-body force equals the
 // model (m . grad) B at the centre of mass (eqs. 2.4.34, 4.5.1) up to the tabulation error,
 // held forces are the last evaluation, and dipole-dipole forces obey Newton's third law.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 
 #include "nipdem/core/rng.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/nip/nip_forces.hpp"
 #include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/analysis.hpp"
+#include "nipdem/analysis/analysis.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/version.hpp"

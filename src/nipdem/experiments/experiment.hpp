@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "nipdem/experiments/ensemble.hpp"
-#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/nip/nip_config.hpp"
 #include "nipdem/io/progress.hpp"
 
 namespace nipdem::experiments {

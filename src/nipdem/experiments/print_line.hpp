@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "nipdem/experiments/experiment.hpp"
-#include "nipdem/experiments/nip.hpp"
+#include "nipdem/nip/nip.hpp"
 
 namespace nipdem::experiments {
 

@@ -6,8 +6,8 @@
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/analysis.hpp"
-#include "nipdem/experiments/nip.hpp"
+#include "nipdem/analysis/analysis.hpp"
+#include "nipdem/nip/nip.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"
 

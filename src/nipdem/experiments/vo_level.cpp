@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/analysis.hpp"
+#include "nipdem/analysis/analysis.hpp"
 
 namespace nipdem::experiments {
 

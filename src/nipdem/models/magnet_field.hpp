@@ -126,7 +126,7 @@ void validate(const ColorPoleParams& c);
 BlockAssembly make_knife(const KnifeParams& k = {});
 BlockAssembly make_color_pole(const ColorPoleParams& c = {});
 
-// Which magnet and toner a preset uses is the presets' knowledge (experiments/presets.hpp).
+// Which magnet and toner a preset uses is the presets' knowledge (nip/presets.hpp).
 
 // A field source placed rigidly in the engine frame: p_engine = origin + R(angle) p_magnet.
 // at() takes an engine-frame point and returns B and dB in the engine frame (B' = R B, dB' = R dB R^T).

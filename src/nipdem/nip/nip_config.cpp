@@ -1,4 +1,4 @@
-#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/nip/nip_config.hpp"
 
 #include <cstdio>
 #include <unistd.h>
@@ -13,7 +13,7 @@
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/io/print_pattern.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include <algorithm>
 #include <filesystem>
 

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/run_driver.hpp"
+#include "nipdem/nip/run_driver.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,9 +1,9 @@
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/embedded_preset_black.hpp"
 #include "nipdem/embedded_preset_color.hpp"
-#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/nip/nip_config.hpp"
 
 namespace nipdem::experiments {
 std::vector<std::string> preset_names() { return {"black", "color"}; }

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 
 #include <algorithm>
 #include <cmath>
