@@ -22,8 +22,8 @@
 #include "bench_args.hpp"
 #include "nipdem/core/wait_policy.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/version.hpp"
 
 using namespace nipdem;

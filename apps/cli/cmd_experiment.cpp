@@ -8,7 +8,10 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/calibrate_cohesion.hpp"
 #include "nipdem/experiments/ensemble.hpp"
-#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/experiments/edge_sharpness.hpp"
+#include "nipdem/experiments/front_position.hpp"
+#include "nipdem/experiments/reduction.hpp"
+#include "nipdem/experiments/vo_level.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "registry.hpp"
 

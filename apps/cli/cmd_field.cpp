@@ -4,10 +4,13 @@
 #include <cstdio>
 #include <fmt/format.h>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/csv.hpp"
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/io/plot.hpp"
@@ -20,20 +23,18 @@ using namespace nipdem;
 struct Common {
   std::string preset = "black";
   std::string map;
-  double radius = 0.0;  // 0 = d50/2 of the preset toner
-  double tip_depth = -1.0;  // < 0: preset default
-  double br = -100.0;       // < -99: preset default
+  std::optional<double> radius;     // default: d50/2 of the preset toner
+  std::optional<double> tip_depth;  // default: the preset magnet's
+  std::optional<double> br;         // default: the preset magnet's
   bool json = false;
-  // Given on the command line? (A given value is checked, never taken for "not given".)
-  CLI::Option *radius_opt = nullptr, *tip_opt = nullptr, *br_opt = nullptr;
 };
 
 // Options that were given are checked against their physical range (never ignored, issue 21).
 void check_common(const Common& c, const std::string& where) {
   if (c.preset != "black" && c.preset != "color") throw_input(where, "--preset", c.preset, "unknown preset", "black, color");
-  if (c.radius_opt && c.radius_opt->count()) require_range(where, "--radius", c.radius, 1e-7, 1e-3);
-  if (c.tip_opt && c.tip_opt->count()) require_range(where, "--tip-depth", c.tip_depth, 0.0, 5e-3);
-  if (c.br_opt && c.br_opt->count()) require_range(where, "--br", c.br, -2.5, 2.5);
+  if (c.radius) require_range(where, "--radius", *c.radius, 1e-7, 1e-3);
+  if (c.tip_depth) require_range(where, "--tip-depth", *c.tip_depth, 0.0, 5e-3);
+  if (c.br) require_range(where, "--br", *c.br, -2.5, 2.5);
 }
 
 struct Setup {
@@ -44,26 +45,15 @@ struct Setup {
 
 Setup make_setup(const Common& c) {
   Setup s;
-  s.toner = magnet::preset_toner(c.preset);
-  s.radius = c.radius == 0.0 ? magnet::preset_d50_radius(c.preset) : c.radius;
+  const experiments::PresetToner t = experiments::preset_toner(c.preset);
+  s.toner = t.magnetisation;
+  s.radius = c.radius.value_or(t.d50_radius_m);
   require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  const bool given_tip = c.tip_opt && c.tip_opt->count(), given_br = c.br_opt && c.br_opt->count();
-  const bool custom = given_tip || given_br;
   if (!c.map.empty()) {
-    if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
+    if (c.tip_depth || c.br) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
     s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
-  } else if (custom && c.preset == "black") {
-    magnet::KnifeParams k;
-    if (given_tip) k.tip_depth_m = c.tip_depth;
-    if (given_br) k.blade_Br_T = c.br;
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
-  } else if (custom && c.preset == "color") {
-    magnet::ColorPoleParams k;
-    if (given_tip) k.tip_depth_m = c.tip_depth;
-    if (given_br) k.Br_T = c.br;
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
   } else {
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
+    s.field = std::make_unique<magnet::BlockAssembly>(experiments::preset_magnet(c.preset, {.tip_depth_m = c.tip_depth, .br_T = c.br}));
   }
   return s;
 }
@@ -71,9 +61,9 @@ Setup make_setup(const Common& c) {
 void add_common(CLI::App* sub, Common& c) {
   sub->add_option("--preset", c.preset, "magnet and toner preset: black or color")->capture_default_str();
   sub->add_option("--map", c.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
-  c.radius_opt = sub->add_option("--radius", c.radius, "toner radius [m] in [1e-7, 1e-3] (default: d50/2 of the preset toner, Table 2.1)");
-  c.tip_opt = sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m], in [0, 5e-3]");
-  c.br_opt = sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T], in [-2.5, 2.5]");
+  sub->add_option("--radius", c.radius, "toner radius [m] in [1e-7, 1e-3] (default: d50/2 of the preset toner, Table 2.1)");
+  sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m], in [0, 5e-3]");
+  sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T], in [-2.5, 2.5]");
   sub->add_flag("--json", c.json, "print one JSON object on stdout");
 }
 
@@ -162,7 +152,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       throw_input("field export", "--nx, --ny", fmt::format("{} x {}", eo->nx, eo->ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
     if (!(eo->x1 > eo->x0)) throw_input("field export", "--x1", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
     if (!(eo->y1 > eo->y0)) throw_input("field export", "--y1", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
-    const auto f = magnet::preset_field(eo->preset);
+    const auto f = experiments::preset_magnet(eo->preset);
     io::write_file_atomic(eo->out, io::field_to_csv(f, eo->x0, eo->x1, eo->nx, eo->y0, eo->y1, eo->ny,
                                                     f.describe() + ", magnet frame (see docs/magnetic.md)"));
     std::fprintf(stderr, "wrote %s (%d x %d nodes)\n", eo->out.c_str(), eo->nx, eo->ny);
@@ -184,9 +174,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
     check_common(lo->c, "field line");
     const Setup s = make_setup(lo->c);
-    std::string csv = fmt::format("# {}; toner preset {}, R = {:g} m; force F = (m.grad)B, m = m(B) of eq. 4.5.1\n",
-                                  s.field->describe(), lo->c.preset, s.radius);
-    csv += "x_m,y_m,Bx_T,By_T,B_T,dBx_dx_T_per_m,dBx_dy_T_per_m,dBy_dx_T_per_m,dBy_dy_T_per_m,mx_Am2,my_Am2,Fx_N,Fy_N,F_N\n";
+    std::vector<std::vector<double>> rows;
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;
     io::Series sb, sfx, sfy;
@@ -198,9 +186,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       const auto smp = s.field->at({x, lo->y});
       const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
       const Vec2 F = magnet::dipole_force(m, smp);
-      csv += fmt::format("{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g},{:.9g}\n",
-                         x, lo->y, smp.B.x, smp.B.y, norm(smp.B), smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy, m.x, m.y,
-                         F.x, F.y, norm(F));
+      rows.push_back({x, lo->y, smp.B.x, smp.B.y, norm(smp.B), smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy, m.x, m.y, F.x, F.y, norm(F)});
       if (i > 0 && (prev_fx > 0) != (F.x > 0))  // linear interpolation of the sign change of F_x
         crossings.push_back(prev_x + (x - prev_x) * prev_fx / (prev_fx - F.x));
       prev_fx = F.x;
@@ -211,7 +197,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
       sfx.y.push_back(F.x * 1e9);
       sfy.y.push_back(F.y * 1e9);
     }
-    io::write_file_atomic(lo->out, csv);
+    const std::vector<std::string> columns = {"x_m", "y_m", "Bx_T", "By_T", "B_T", "dBx_dx_T_per_m", "dBx_dy_T_per_m", "dBy_dx_T_per_m",
+                                              "dBy_dy_T_per_m", "mx_Am2", "my_Am2", "Fx_N", "Fy_N", "F_N"};
+    io::write_file_atomic(lo->out, fmt::format("# {}; toner preset {}, R = {:g} m; force F = (m.grad)B, m = m(B) of eq. 4.5.1\n",
+                                               s.field->describe(), lo->c.preset, s.radius) +
+                                       io::format_csv(columns, rows, std::vector<std::string>(columns.size(), "{:.9g}")));
     // The picture of the same data (thesis fig. 2.12 analogue), next to the CSV.
     std::filesystem::path png = lo->out;
     png.replace_extension(".png");

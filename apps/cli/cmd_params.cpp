@@ -2,8 +2,8 @@
 #include <nlohmann/json.hpp>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "registry.hpp"
 

@@ -1,7 +1,7 @@
 // `nipdem presets list` and `nipdem presets show NAME`
 #include <cstdio>
 
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "registry.hpp"
 
 namespace {

@@ -1,7 +1,7 @@
 // `nipdem run CONFIG.toml [--out DIR] [--set KEY=VALUE]... [--resume] [--force] [--json]`
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/run_driver.hpp"
+#include "nipdem/nip/run_driver.hpp"
 #include "registry.hpp"
 
 namespace {

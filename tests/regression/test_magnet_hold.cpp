@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 
 using namespace nipdem;
 using namespace nipdem::experiments;

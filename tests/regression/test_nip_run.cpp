@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 using namespace nipdem;

@@ -15,8 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "../cli_run.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/nip_config.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;

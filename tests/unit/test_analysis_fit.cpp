@@ -7,7 +7,7 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 
 using namespace nipdem;
 using namespace nipdem::analysis;
@@ -210,7 +210,7 @@ TEST(AnalysisSigmoid, BadInputIsAnInputError) {
 
 #include <filesystem>
 
-#include "nipdem/experiments/analysis_report.hpp"
+#include "nipdem/analysis/report.hpp"
 #include "nipdem/io/csv.hpp"
 
 TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {
@@ -287,4 +287,50 @@ TEST(AnalysisRangeEnds, BelowTheThresholdIsNotCutAndBadCurvesAreInputErrors) {
   EXPECT_TRUE(range_end_coverage(c).end_cut);
   EXPECT_THROW(range_end_coverage(std::vector<double>(10, 0.0)), InputError);
   EXPECT_THROW(range_end_coverage(std::vector<double>{1.0}), InputError);
+}
+
+// The one fitter's options for a constrained fit (the probe-circuit calibration uses them): a
+// fixed parameter keeps its start value, trial points stay inside the box, a step is capped.
+TEST(LevenbergMarquardt, FixedParametersBoundsAndStepCap) {
+  // residuals r_i = a + b x_i - y_i with y = 2 + 3 x: the free optimum is (2, 3)
+  const std::vector<double> xs = {0.0, 1.0, 2.0, 3.0};
+  std::vector<Eigen::VectorXd> seen;
+  LmModel model = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
+    seen.push_back(p);
+    r.resize(4);
+    J.resize(4, 2);
+    for (int i = 0; i < 4; ++i) {
+      r[i] = p[0] + p[1] * xs[i] - (2.0 + 3.0 * xs[i]);
+      J(i, 0) = 1.0;
+      J(i, 1) = xs[i];
+    }
+  };
+  const Eigen::VectorXd p0 = Eigen::Vector2d(0.0, 0.0);
+  const LmResult free_fit = levenberg_marquardt(model, p0, 4);
+  EXPECT_NEAR(free_fit.p[0], 2.0, 1e-6);
+  EXPECT_NEAR(free_fit.p[1], 3.0, 1e-6);
+  // b fixed at 0: the best a is the mean of y = 2 + 3 * 1.5
+  LmOptions fixed;
+  fixed.free = {true, false};
+  const LmResult f = levenberg_marquardt(model, p0, 4, fixed);
+  EXPECT_EQ(f.p[1], 0.0);
+  EXPECT_NEAR(f.p[0], 6.5, 1e-6);
+  EXPECT_TRUE(f.converged);
+  // a box a <= 1: the fit ends on the bound with b taking up the rest; no trial point outside
+  LmOptions box;
+  box.lower = Eigen::Vector2d(-10.0, -10.0);
+  box.upper = Eigen::Vector2d(1.0, 10.0);
+  seen.clear();
+  const LmResult b = levenberg_marquardt(model, p0, 4, box);
+  EXPECT_NEAR(b.p[0], 1.0, 1e-9);
+  for (const auto& p : seen) EXPECT_LE(p[0], 1.0);
+  // a step cap of 0.5: every trial point within 0.5 of the accepted point before it
+  LmOptions cap;
+  cap.max_step = 0.5;
+  cap.strict_decrease = true;
+  seen.clear();
+  const LmResult c = levenberg_marquardt(model, p0, 4, cap);
+  EXPECT_NEAR(c.p[1], 3.0, 1e-6);
+  EXPECT_GE(c.iterations, 6);  // 3 / 0.5 steps at least for b
+  for (std::size_t k = 1; k < seen.size(); ++k) EXPECT_LE((seen[k] - seen[k - 1]).cwiseAbs().maxCoeff(), 1.0 + 1e-12);
 }

@@ -5,8 +5,8 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/analysis_reduction.hpp"
-#include "nipdem/experiments/analysis_vo.hpp"
+#include "nipdem/analysis/reduction.hpp"
+#include "nipdem/analysis/vo.hpp"
 
 using namespace nipdem;
 using namespace nipdem::analysis;

@@ -5,7 +5,7 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/analysis_steady.hpp"
+#include "nipdem/analysis/steady.hpp"
 
 using namespace nipdem;
 using namespace nipdem::analysis;

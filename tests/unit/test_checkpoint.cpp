@@ -14,8 +14,8 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/checkpoint_file.hpp"
 
 using namespace nipdem;

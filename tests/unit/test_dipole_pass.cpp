@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/nip/nip_forces.hpp"
 #include "nipdem/models/dipole.hpp"
 
 using namespace nipdem;

@@ -8,10 +8,10 @@
 #include <cmath>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/nip_forces.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/nip_forces.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;

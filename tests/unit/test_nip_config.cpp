@@ -13,8 +13,8 @@
 
 #include "../cli_run.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/models/hamaker.hpp"
@@ -201,4 +201,96 @@ TEST(NipInteractions, TangentialSpringIsTwoSeventhsAndCohesionIsRTimesAdhesion) 
   const double f_adh = std::fabs(models::hamaker_force(ia[1].adhesion, r50, std::numeric_limits<double>::infinity(), 0.0));
   EXPECT_NEAR(f_adh, c.adhesion_roller_force, 1e-12 * c.adhesion_roller_force);
   EXPECT_NEAR(f_coh / f_adh, 3.0, 1e-9);
+}
+
+namespace {
+// Leaf values of two resolved configurations, numbers compared as numbers (1 == 1.0).
+void expect_same_leaves(const toml::table& a, const toml::table& b, const std::string& prefix = "") {
+  std::set<std::string> ka, kb;
+  for (const auto& [k, v] : a) ka.insert(std::string(k.str()));
+  for (const auto& [k, v] : b) kb.insert(std::string(k.str()));
+  EXPECT_EQ(ka, kb) << "in [" << prefix << "]";
+  for (const auto& k : ka) {
+    if (!kb.count(k)) continue;
+    const toml::node& va = *a.get(k);
+    const toml::node& vb = *b.get(k);
+    const std::string key = prefix.empty() ? k : prefix + "." + k;
+    if (va.is_table() && vb.is_table()) {
+      expect_same_leaves(*va.as_table(), *vb.as_table(), key);
+    } else if (va.value<double>() && vb.value<double>() && !va.is_boolean()) {
+      EXPECT_EQ(*va.value<double>(), *vb.value<double>()) << key;
+    } else {
+      std::ostringstream sa, sb;
+      sa << toml::node_view<const toml::node>(&va);
+      sb << toml::node_view<const toml::node>(&vb);
+      EXPECT_EQ(sa.str(), sb.str()) << key;
+    }
+  }
+}
+}  // namespace
+
+TEST(NipConfigTyped, TheFieldsAloneGiveTheWholeResolvedConfiguration) {
+  // validate() writes every field into the table: a configuration whose table is emptied still
+  // serializes every key with the same value (no key lives only in the table).
+  for (const auto& p : preset_names()) {
+    SCOPED_TRACE(p);
+    const NipConfig a = parse_nip_config(preset_text(p), "preset:" + p, {"electric.enabled=true", "print.pattern=\"line\"",
+                                                                          "print.start_m=1e-4", "print.length_m=2e-4"});
+    NipConfig b = a;
+    b.table = toml::table{};
+    validate(b);
+    expect_same_leaves(io::parse_toml(b.resolved_toml, "b"), io::parse_toml(a.resolved_toml, "a"));
+  }
+}
+
+TEST(NipConfigTyped, EditingFieldsEqualsTheSameOverrides) {
+  // What an experiment does to a point (typed edits + validate) gives the configuration, the
+  // resume key and the print-prefix key that the same values as --set overrides give.
+  const std::string text = preset_text("color");
+  const NipConfig base = read_nip_config(text, "preset:color", {"collision.stiffness_scale=0.01"});
+  NipConfig c = base;
+  c.gap = 1.2e-4;
+  c.roller_speed = 0.25;
+  c.cohesion_ratio = 2.5;
+  c.roller_pits_filled = false;
+  c.x_min = -2.5e-4;
+  c.x_max = 2.5e-4;
+  c.vtk = false;
+  c.seed = 7;
+  set_print_line(c, 1e-5, 2e-5, 35.5);
+  validate(c);
+  const NipConfig s = parse_nip_config(
+      text, "preset:color",
+      {"collision.stiffness_scale=0.01", "geometry.gap_m=1.2e-4", "geometry.roller_surface_speed_m_per_s=0.25",
+       "adhesion.cohesion_ratio=2.5", "inflow.roller_pits=\"empty\"", "geometry.window_x_min_m=-2.5e-4", "geometry.window_x_max_m=2.5e-4",
+       "output.vtk=false", "run.seed=7", "electric.enabled=true", "print.pattern=\"line\"", "print.start_m=1e-5", "print.length_m=2e-5",
+       "print.voltage_V=35.5"});
+  EXPECT_EQ(c.resolved_toml, s.resolved_toml);
+  EXPECT_EQ(c.resume_key, s.resume_key);
+  EXPECT_EQ(c.prefix_key, s.prefix_key);
+  ASSERT_EQ(c.electric.pattern.segments().size(), 1u);
+  EXPECT_EQ(c.electric.pattern.segments()[0].voltage_V, 35.5);
+  EXPECT_EQ(c.electric.drum_centre.y, c.gap + c.drum_radius);  // derived from the edited gap
+  // the base is untouched, and its own validation still gives the unedited configuration
+  NipConfig b = base;
+  validate(b);
+  EXPECT_EQ(b.resolved_toml, parse_nip_config(text, "preset:color", {"collision.stiffness_scale=0.01"}).resolved_toml);
+  EXPECT_NE(b.resume_key, c.resume_key);
+}
+
+TEST(NipConfigTyped, ValidateChecksAnEditedConfiguration) {
+  NipConfig c = read_nip_config(preset_text("black"), "preset:black");
+  c.gap = 0.5 * c.size.d_max();
+  try {
+    validate(c);
+    FAIL() << "a gap below the largest particle passed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("geometry.gap_m"), std::string::npos) << e.what();
+  }
+  NipConfig d = read_nip_config("", "empty.toml");  // the black preset, no [print] of its own
+  d.electric.enabled = true;
+  EXPECT_THROW(validate(d), InputError);
+  set_print_line(d, 0.0, 1e-4);
+  EXPECT_NO_THROW(validate(d));
+  EXPECT_EQ(d.electric.pattern.segments().size(), 1u);
 }

@@ -1,4 +1,4 @@
-// The magnet force provider of the nip (experiments/nip_forces): per-body force equals the
+// The magnet force provider of the nip (nip/nip_forces): per-body force equals the
 // model (m . grad) B at the centre of mass (eqs. 2.4.34, 4.5.1) up to the tabulation error,
 // held forces are the last evaluation, and dipole-dipole forces obey Newton's third law.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 
 #include "nipdem/core/rng.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/nip/nip_forces.hpp"
 #include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;
@@ -101,7 +101,7 @@ TEST(NipMagnetForce, ThreadedDipolePassEqualsSerial) {
 TEST(NipMagnetForce, AMapAskedOutsideItsRangeFailsCleanlyOnAnyThreadCount) {
   // A failure inside the threaded field pass (here: a body outside the field map) must come out
   // of the OpenMP region as the same InputError as with one thread, never std::terminate.
-  auto field = std::make_shared<io::FieldMap>(io::FieldMap::sample(magnet::preset_field("black"), -200e-6, 200e-6, 41, 0.0, 200e-6, 21));
+  auto field = std::make_shared<io::FieldMap>(io::FieldMap::sample(magnet::make_knife(), -200e-6, 200e-6, 41, 0.0, 200e-6, 21));
   BodyStore b = bodies(64, 9);
   b.x[40] = 500e-6;  // outside the map
   b.x[50] = -600e-6;

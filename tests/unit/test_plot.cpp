@@ -12,13 +12,13 @@
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"
 #include "nipdem/io/render.hpp"
-#include "nipdem/experiments/analysis_report.hpp"
+#include "nipdem/analysis/report.hpp"
 
 using namespace nipdem;
 namespace fs = std::filesystem;

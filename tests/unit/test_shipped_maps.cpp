@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 
 TEST(FieldMap, ShippedMapsCoverThePresets) {
   for (const auto& [preset, file] : {std::pair{"black", "knife_black_25um.csv"}, std::pair{"color", "pole_color_25um.csv"}}) {

@@ -6,7 +6,7 @@
 #include <numeric>
 
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/toner.hpp"
+#include "nipdem/nip/toner.hpp"
 
 using namespace nipdem;
 using namespace nipdem::experiments;

@@ -8,6 +8,7 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"
 #include "nipdem/version.hpp"
 
@@ -242,7 +243,7 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
   if (width > 0.0) t.pile_width_m = width;
   const CountFit f = fit_cohesion_from_counts(pts, t);
 
-  std::string csv = "r,seeds,removed_mean,removed_stderr\n";
+  std::vector<std::vector<double>> csv;
   io::Series s, raw;
   s.label = "mean over seeds (± standard error)";
   s.markers = true;
@@ -252,7 +253,7 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
   raw.line = false;
   raw.marker_size = 2.5;
   for (const auto& row : f.rows) {
-    csv += fmt::format("{:.8g},{},{:.8g},{:.8g}\n", row.r, row.n, row.mean, row.stderr_);
+    csv.push_back({row.r, static_cast<double>(row.n), row.mean, row.stderr_});
     s.x.push_back(row.r);
     s.y.push_back(row.mean);
     s.y_err.push_back(row.stderr_);
@@ -261,7 +262,7 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
     raw.x.push_back(p.r);
     raw.y.push_back(p.removed);
   }
-  io::write_file_atomic(o.out / "cohesion.csv", csv);
+  io::write_csv(o.out / "cohesion.csv", {"r", "seeds", "removed_mean", "removed_stderr"}, csv, {"{:.8g}", "{:.0f}", "{:.8g}", "{:.8g}"});
   io::PlotSpec plot;
   plot.title = "Cohesion ratio from removed toner (§4.6, fig. 4.25, Table 4.3)";
   plot.x_label = "r = F_coh / F_adh";
@@ -340,18 +341,19 @@ json calibrate_cohesion(const experiments::ExperimentOptions& o, const CohesionO
   const auto& pts = search.points;
   const auto& fit = search.fit;
 
-  std::string csv = "r,reduction_speed_m_per_s,reduction_speed_stderr_m_per_s\n";
+  std::vector<std::vector<double>> csv;
   io::Series s;
   s.label = "simulated reduction speed";
   s.line = false;
   s.markers = true;
   for (const auto& p : pts) {
-    csv += fmt::format("{:.8g},{:.8g},{:.8g}\n", p.r, p.speed, p.stderr_);
+    csv.push_back({p.r, p.speed, p.stderr_});
     s.x.push_back(p.r);
     s.y.push_back(p.speed * 1e3);
     s.y_err.push_back(p.stderr_ * 1e3);
   }
-  io::write_file_atomic(o.out / "cohesion.csv", csv);
+  io::write_csv(o.out / "cohesion.csv", {"r", "reduction_speed_m_per_s", "reduction_speed_stderr_m_per_s"}, csv,
+                std::vector<std::string>(3, "{:.8g}"));
   if (!pts.empty()) {
     io::PlotSpec plot;
     plot.title = "Cohesion ratio from the reduction speed (§4.6, Table 4.3)";

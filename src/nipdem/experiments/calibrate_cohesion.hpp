@@ -20,7 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/experiments/reduction.hpp"
 
 namespace nipdem::calibrate {
 

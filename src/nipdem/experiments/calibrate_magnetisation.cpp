@@ -9,7 +9,7 @@
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/csv.hpp"
 #include "nipdem/io/plot.hpp"

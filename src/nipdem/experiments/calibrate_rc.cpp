@@ -9,6 +9,7 @@
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
+#include "nipdem/analysis/fit.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace nipdem::probe {
@@ -56,6 +57,7 @@ Vec residual(const Ctx& c, const double x[3]) {
   return r;
 }
 
+// Central-difference Jacobian of the residuals in the free components of x (others: 0).
 Mat jacobian(const Ctx& c, const double x[3], const bool free[3]) {
   const std::size_t m = 2 * c.data->size();
   Mat J = Mat::Zero(static_cast<Eigen::Index>(m), 3);
@@ -76,60 +78,30 @@ struct LmOut {
   bool converged = false;
 };
 
-// Levenberg–Marquardt on the free components of x (in place), kept inside the search box.
+// Levenberg–Marquardt (analysis::levenberg_marquardt) on the free components of x (in place),
+// kept inside the search box, at most a factor e^2 per step; central-difference Jacobian.
 LmOut levenberg_marquardt(const Ctx& c, double x[3], const bool free[3], int max_it) {
-  Vec r = residual(c, x);
-  double chi2 = r.squaredNorm();
-  double lambda = 1e-3;
-  LmOut out;
-  for (int it = 0; it < max_it; ++it) {
-    out.iterations = it + 1;
-    const Mat J = jacobian(c, x, free);
-    Mat A = J.transpose() * J;
-    const Vec g = J.transpose() * r;
-    const double dmax = std::max(A.diagonal().maxCoeff(), 1e-300);
-    bool accepted = false;
-    double step = 0.0, chi2_new = chi2;
-    for (int tries = 0; tries < 30 && !accepted; ++tries) {
-      Mat M = A;
-      for (int k = 0; k < 3; ++k) {
-        if (!free[k]) {
-          M.row(k).setZero();
-          M.col(k).setZero();
-          M(k, k) = 1.0;
-        } else {
-          M(k, k) += lambda * std::max(A(k, k), 1e-9 * dmax);
-        }
-      }
-      Vec gg = g;
-      for (int k = 0; k < 3; ++k)
-        if (!free[k]) gg[k] = 0.0;
-      Vec delta = M.ldlt().solve(-gg);
-      const double big = delta.cwiseAbs().maxCoeff();
-      if (!(big < kInf)) { lambda *= 10; continue; }
-      if (big > 2.0) delta *= 2.0 / big;  // trust region: at most a factor e^2 per step
-      double xn[3];
-      for (int k = 0; k < 3; ++k) xn[k] = std::clamp(x[k] + delta[k], kLo[k], kHi[k]);
-      const Vec rn = residual(c, xn);
-      chi2_new = rn.squaredNorm();
-      if (chi2_new < chi2) {
-        step = 0.0;
-        for (int k = 0; k < 3; ++k) step = std::max(step, std::fabs(xn[k] - x[k]));
-        for (int k = 0; k < 3; ++k) x[k] = xn[k];
-        r = rn;
-        accepted = true;
-        lambda = std::max(lambda / 3.0, 1e-12);
-      } else {
-        lambda *= 4.0;
-      }
-    }
-    if (!accepted) { out.converged = true; break; }  // no downhill step left: at a minimum
-    const double drop = chi2 - chi2_new;
-    chi2 = chi2_new;
-    if (drop <= 1e-12 * chi2 + 1e-300 || step < 1e-10) { out.converged = true; break; }
-  }
-  out.chi2 = chi2;
-  return out;
+  analysis::LmModel model = [&](const Vec& p, Vec& r, Mat& J) {
+    const double xp[3] = {p[0], p[1], p[2]};
+    r = residual(c, xp);
+    J = jacobian(c, xp, free);
+  };
+  analysis::LmOptions o;
+  o.max_iterations = max_it;
+  o.stop = analysis::LmOptions::Stop::absolute;
+  o.tol_drop = 1e-12;
+  o.tol_step = 1e-10;
+  o.free = {free[0], free[1], free[2]};
+  o.lower = Vec::Map(kLo, 3);
+  o.upper = Vec::Map(kHi, 3);
+  o.max_step = 2.0;  // trust region: at most a factor e^2 per step
+  o.damping_floor = 1e-9;
+  o.strict_decrease = true;
+  o.lambda_cap = kInf;
+  o.max_tries = 30;
+  const analysis::LmResult fit = analysis::levenberg_marquardt(model, Vec::Map(x, 3), 2 * c.data->size(), o);
+  for (int k = 0; k < 3; ++k) x[k] = fit.p[k];
+  return {fit.rss, fit.iterations, fit.converged};
 }
 
 // Initial R, C assuming Rd -> inf: Vm/V = Rm i w C / (1 + i w C (R + Rm)).

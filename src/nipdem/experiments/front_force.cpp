@@ -81,9 +81,11 @@ double FrontForceModel::crossing(double x, bool printed, double lo, double hi) c
 
 FrontForceModel make_front_force_model(const ExperimentOptions& e, const FrontForceOptions& f) {
   f.validate();
-  reject_fixed_sets(e, "front-force", {"geometry.gap_m=*"}, {{"geometry.gap_m", "--gap"}}, false);
+  reject_fixed_sets(e, "front-force", {{"geometry.gap_m", std::monostate{}, "--gap"}}, false);
   FrontForceModel m;
-  m.cfg = experiment_config(e, {fmt::format("geometry.gap_m={:.17g}", f.gap_m)});
+  m.cfg = base_config(e);
+  m.cfg.gap = f.gap_m;
+  validate(m.cfg);
   m.field = make_magnet_field(m.cfg.magnet);
   m.radius_m = 0.5 * m.cfg.size.d_small;  // R = d95/2 (§2.5.4; Table 2.1 "d95")
   double v = f.voltage_V;

@@ -6,7 +6,7 @@
 //     (2x the physical force, docs/electric.md). It acts along the drum normal; its y-component
 //     counts. No screening: as in the thesis this is an upper estimate (§2.5.4);
 //   - the magnet's force on its induced moment, F = (m . grad) B with m of eq. 4.5.1 (eq. 2.4.34),
-//     from the configuration's magnet field (experiments/nip_forces.hpp make_magnet_field).
+//     from the configuration's magnet field (nip/nip_forces.hpp make_magnet_field).
 // The net y-force is positive towards the drum. Everything comes from a NipConfig (preset or
 // file, with --set overrides), with the gap set to the one asked for (the thesis takes the
 // maximal gap: the weakest magnet pull, hence the largest net force to the drum of any setting).
@@ -21,7 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/experiments/experiment.hpp"
 
 namespace nipdem::experiments {
 

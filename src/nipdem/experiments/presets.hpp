@@ -1,10 +1,4 @@
-// CPS700 presets (data/presets/*.toml, embedded at build time).
+// Moved to nipdem/nip/presets.hpp (the nip scenario, docs/ARCHITECTURE.md). This forwarding header
+// keeps fuzz/ building until its includes name the new place; do not include it in new code.
 #pragma once
-#include <string>
-#include <vector>
-
-namespace nipdem::experiments {
-std::vector<std::string> preset_names();
-// Complete TOML text of a preset; throws InputError for an unknown name.
-std::string preset_text(const std::string& name);
-}  // namespace nipdem::experiments
+#include "nipdem/nip/presets.hpp"

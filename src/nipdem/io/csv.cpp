@@ -63,25 +63,63 @@ std::vector<double> CsvTable::column(const std::string& name) const {
   return v;
 }
 
-std::string format_csv(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows) {
+namespace {
+std::string header_line(const std::vector<std::string>& columns, const char* who) {
   std::string out;
   for (std::size_t j = 0; j < columns.size(); ++j) {
     if (columns[j].find_first_of(",\n\r") != std::string::npos)
-      throw std::invalid_argument("format_csv: column name '" + columns[j] + "' contains a comma or newline");
+      throw std::invalid_argument(std::string(who) + ": column name '" + columns[j] + "' contains a comma or newline");
     out += (j ? "," : "") + columns[j];
   }
-  out += '\n';
+  return out + '\n';
+}
+}  // namespace
+
+std::string format_csv_cells(const std::vector<std::string>& columns, const std::vector<std::vector<std::string>>& rows) {
+  std::string out = header_line(columns, "format_csv_cells");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     if (rows[i].size() != columns.size())
-      throw std::invalid_argument(fmt::format("format_csv: row {} has {} values, header has {}", i, rows[i].size(),
-                                              columns.size()));
+      throw std::invalid_argument(fmt::format("format_csv_cells: row {} has {} values, header has {}", i, rows[i].size(), columns.size()));
     for (std::size_t j = 0; j < rows[i].size(); ++j) {
+      if (rows[i][j].find_first_of(",\n\r") != std::string::npos)
+        throw std::invalid_argument(fmt::format("format_csv_cells: row {} column '{}' holds a comma or newline", i, columns[j]));
       if (j) out += ',';
-      out += fmt::format("{}", rows[i][j]);
+      out += rows[i][j];
     }
     out += '\n';
   }
   return out;
+}
+
+std::string format_csv_header(const std::vector<std::string>& columns) { return header_line(columns, "format_csv"); }
+
+std::string format_csv_row(const std::vector<double>& values, const std::vector<std::string>& formats) {
+  if (formats.size() != values.size())
+    throw std::invalid_argument(fmt::format("format_csv_row: {} formats for {} values", formats.size(), values.size()));
+  std::string out;
+  for (std::size_t j = 0; j < values.size(); ++j) {
+    if (j) out += ',';
+    out += fmt::format(fmt::runtime(formats[j]), values[j]);
+  }
+  return out + '\n';
+}
+
+std::string format_csv(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows,
+                       const std::vector<std::string>& formats) {
+  if (formats.size() != columns.size())
+    throw std::invalid_argument(fmt::format("format_csv: {} formats for {} columns", formats.size(), columns.size()));
+  std::string out = header_line(columns, "format_csv");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (rows[i].size() != columns.size())
+      throw std::invalid_argument(fmt::format("format_csv: row {} has {} values, header has {}", i, rows[i].size(),
+                                              columns.size()));
+    out += format_csv_row(rows[i], formats);
+  }
+  return out;
+}
+
+std::string format_csv(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows) {
+  return format_csv(columns, rows, std::vector<std::string>(columns.size(), "{}"));
 }
 
 std::string format_csv_columns(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& data) {
@@ -99,6 +137,11 @@ std::string format_csv_columns(const std::vector<std::string>& columns, const st
 void write_csv(const std::filesystem::path& path, const std::vector<std::string>& columns,
                const std::vector<std::vector<double>>& rows) {
   write_file_atomic(path, format_csv(columns, rows));
+}
+
+void write_csv(const std::filesystem::path& path, const std::vector<std::string>& columns,
+               const std::vector<std::vector<double>>& rows, const std::vector<std::string>& formats) {
+  write_file_atomic(path, format_csv(columns, rows, formats));
 }
 
 CsvTable parse_csv(std::string_view text, const std::string& source) {

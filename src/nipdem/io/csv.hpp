@@ -35,9 +35,22 @@ std::string format_csv(const std::vector<std::string>& columns, const std::vecto
 // Same from columns of equal length: data[j] is column j.
 std::string format_csv_columns(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& data);
 
+// Same with one fmt format per column, e.g. "{:.6g}", "{:.0f}" for a count; "{}" is the
+// shortest round-trip form. NaN is written "nan".
+std::string format_csv(const std::vector<std::string>& columns, const std::vector<std::vector<double>>& rows,
+                       const std::vector<std::string>& formats);
+// The header line, and one row of numbers (formats as above), for a file that grows row by row.
+std::string format_csv_header(const std::vector<std::string>& columns);
+std::string format_csv_row(const std::vector<double>& values, const std::vector<std::string>& formats);
+// Cells already formatted (a text column, an empty cell, a list within a cell): the header and
+// the framing only. A cell must not hold a comma or a newline.
+std::string format_csv_cells(const std::vector<std::string>& columns, const std::vector<std::vector<std::string>>& rows);
+
 // Writes atomically (temp file then rename).
 void write_csv(const std::filesystem::path& path, const std::vector<std::string>& columns,
                const std::vector<std::vector<double>>& rows);
+void write_csv(const std::filesystem::path& path, const std::vector<std::string>& columns,
+               const std::vector<std::vector<double>>& rows, const std::vector<std::string>& formats);
 
 // Parses CSV text; `source` names the origin in error messages.
 CsvTable parse_csv(std::string_view text, const std::string& source);

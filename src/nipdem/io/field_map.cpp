@@ -1,5 +1,7 @@
 #include "nipdem/io/field_map.hpp"
 
+#include "nipdem/io/csv.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -275,16 +277,16 @@ FieldMap FieldMap::from_file(const std::filesystem::path& path) { return from_cs
 std::string field_to_csv(const magnet::MagnetField& field, double x0, double x1, int nx, double y0, double y1, int ny,
                          const std::string& comment) {
   if (nx < 2 || ny < 2) throw_input("field_to_csv", "nx/ny", fmt::format("{}/{}", nx, ny), "too few nodes", ">= 2");
-  std::string out;
-  if (!comment.empty()) out += "# " + comment + "\n";
-  out += "x_m,y_m,Bx_T,By_T\n";
+  std::vector<std::vector<double>> rows;
+  rows.reserve(static_cast<std::size_t>(nx) * ny);
   for (int j = 0; j < ny; ++j)
     for (int i = 0; i < nx; ++i) {
       const double x = x0 + (x1 - x0) * i / (nx - 1), y = y0 + (y1 - y0) * j / (ny - 1);
       const auto s = field.at({x, y});
-      out += fmt::format("{:.17g},{:.17g},{:.17g},{:.17g}\n", x, y, s.B.x, s.B.y);
+      rows.push_back({x, y, s.B.x, s.B.y});
     }
-  return out;
+  return (comment.empty() ? std::string() : "# " + comment + "\n") +
+         format_csv({"x_m", "y_m", "Bx_T", "By_T"}, rows, {"{:.17g}", "{:.17g}", "{:.17g}", "{:.17g}"});
 }
 
 }  // namespace nipdem::io

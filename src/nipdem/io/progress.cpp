@@ -7,8 +7,11 @@
 namespace nipdem::io {
 
 Progress::Progress(std::string label, double t_start, double t_end, std::int64_t step_start)
-    : label_(std::move(label)), t0_(t_start), t1_(t_end), s0_(step_start), tty_(::isatty(2) != 0),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+    : Progress(std::move(label), t_start, t_end, step_start, Style{}) {}
+
+Progress::Progress(std::string label, double t_start, double t_end, std::int64_t step_start, Style style)
+    : label_(std::move(label)), t0_(t_start), t1_(t_end), s0_(step_start), style_(style),
+      tty_(style.bar && ::isatty(2) != 0), start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 double Progress::elapsed_s() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
@@ -20,14 +23,17 @@ double Progress::steps_per_s(std::int64_t steps) const {
 }
 
 void Progress::update(double t, std::int64_t steps, const std::string& extra) {
+  if (!style_.enabled) return;
   const auto now = std::chrono::steady_clock::now();
   const double since = std::chrono::duration<double>(now - last_).count();
-  if (since < (tty_ ? 0.2 : 5.0)) return;
+  if (since < (tty_ ? 0.2 : style_.every_s)) return;
   last_ = now;
   print(t, steps, extra, false);
 }
 
-void Progress::finish(double t, std::int64_t steps, const std::string& extra) { print(t, steps, extra, true); }
+void Progress::finish(double t, std::int64_t steps, const std::string& extra) {
+  if (style_.enabled) print(t, steps, extra, true);
+}
 
 void Progress::print(double t, std::int64_t steps, const std::string& extra, bool final) {
   const double frac = t1_ > t0_ ? std::min(1.0, std::max(0.0, (t - t0_) / (t1_ - t0_))) : 1.0;

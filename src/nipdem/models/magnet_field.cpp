@@ -204,24 +204,6 @@ BlockAssembly make_color_pole(const ColorPoleParams& c) {
                        "colour magnet pole");
 }
 
-BlockAssembly preset_field(const std::string& name) {
-  if (name == "black") return make_knife();
-  if (name == "color") return make_color_pole();
-  throw_input("magnet", "preset", name, "unknown magnet preset", "black, color");
-}
-
-MagnetisationParams preset_toner(const std::string& name) {
-  if (name == "black") return black_toner();
-  if (name == "color") return color_toner();
-  throw_input("magnet", "preset", name, "unknown toner preset", "black, color");
-}
-
-double preset_d50_radius(const std::string& name) {
-  if (name == "black") return 0.5 * 10.5e-6;  // Table 2.1, d50 = 10.5 um
-  if (name == "color") return 0.5 * 12e-6;    // Table 2.1, d50 = 12 um
-  throw_input("magnet", "preset", name, "unknown toner preset", "black, color");
-}
-
 PlacedField::PlacedField(std::shared_ptr<const MagnetField> inner, Vec2 origin_m, double angle_rad)
     : inner_(std::move(inner)), origin_(origin_m), c_(std::cos(angle_rad)), s_(std::sin(angle_rad)) {
   if (!inner_) throw_input("magnet.placed", "inner", "null", "no field source given");

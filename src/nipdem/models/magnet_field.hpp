@@ -126,11 +126,7 @@ void validate(const ColorPoleParams& c);
 BlockAssembly make_knife(const KnifeParams& k = {});
 BlockAssembly make_color_pole(const ColorPoleParams& c = {});
 
-// Preset by name: "black" (make_knife()) or "color" (make_color_pole()); InputError otherwise.
-BlockAssembly preset_field(const std::string& name);
-// Magnetisation curve of the toner of a preset ("black" or "color") and its d50 radius [m] (Table 2.1).
-MagnetisationParams preset_toner(const std::string& name);
-double preset_d50_radius(const std::string& name);
+// Which magnet and toner a preset uses is the presets' knowledge (nip/presets.hpp).
 
 // A field source placed rigidly in the engine frame: p_engine = origin + R(angle) p_magnet.
 // at() takes an engine-frame point and returns B and dB in the engine frame (B' = R B, dB' = R dB R^T).

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_report.hpp"
+#include "nipdem/analysis/report.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/nip/nip_config.hpp"
 
 #include <cstdio>
 #include <unistd.h>
@@ -13,7 +13,7 @@
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/toml_reader.hpp"
 #include "nipdem/io/print_pattern.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/presets.hpp"
 #include <algorithm>
 #include <filesystem>
 
@@ -72,11 +72,12 @@ namespace {
 void check_resource_bounds(const NipConfig& c, const TimeStep& ts);
 }  // namespace
 
-NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+NipConfig read_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
   toml::table user;
-  toml::table root = resolve(text, file, overrides, user);
-  const bool user_print = user.contains("print");
   NipConfig c;
+  c.table = resolve(text, file, overrides, user);
+  toml::table& root = c.table;
+  c.print_given = user.contains("print");
   c.file = file;
   io::Section top(&root, file, "");
   c.preset = top.choice("preset", preset_names());
@@ -185,6 +186,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     if (c.magnet.field == "map" && c.magnet.map_file.empty())
       throw_input(file, "magnet.map_file", "", "field = \"map\" needs a map_file (CSV x_m,y_m,Bx_T,By_T)");
     const std::string pig = s.choice("pigment", {"black", "color"});
+    c.magnet_pigment = pig;
     const magnet::MagnetisationParams p = pig == "black" ? magnet::black_toner() : magnet::color_toner();
     c.magnet.toner = p;
     c.magnet.toner.Ms_A_per_m = derived(s, "saturation_magnetisation_A_per_m", 1e-3, 1e7, p.Ms_A_per_m);
@@ -196,7 +198,6 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     c.magnet.dipole_interval = static_cast<int>(s.integer("dipole_interval_steps", 1, 100000));
     c.magnet.field_interval = static_cast<int>(s.integer("field_interval_steps", 1, 100000));
     s.finish();
-    if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
   }
   {
     auto s = top.sub("electric");
@@ -207,7 +208,8 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     e.dielectric_layer = s.boolean("dielectric_layer");
     e.layer_thickness = s.number("layer_thickness_m", 0.0, 1e-4);
     e.layer_permittivity = s.number("layer_permittivity", 1.0, 1e4);
-    const auto rc = s.choice("charge_preset", {"black", "color"}) == "black" ? charge::RcChargeParams::black() : charge::RcChargeParams::colour();
+    c.charge_preset = s.choice("charge_preset", {"black", "color"});
+    const auto rc = c.charge_preset == "black" ? charge::RcChargeParams::black() : charge::RcChargeParams::colour();
     e.rc = rc;
     e.rc.R_tt_ohm = derived(s, "R_tt_ohm", 1.0, 1e30, rc.R_tt_ohm);
     e.rc.R_ti_ohm = derived(s, "R_ti_ohm", 1.0, 1e30, rc.R_ti_ohm);
@@ -219,14 +221,10 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     s.finish();
     e.force.validate();
     e.rc.validate();
-    e.drum_speed = c.drum_speed;
-    e.drum_centre = {c.nip_x, c.gap + c.drum_radius};
-    e.drum_radius = c.drum_radius;
     toml::table* print = root["print"].as_table();
-    top.sub("print");  // its keys are checked by the pattern parser
+    top.sub("print");  // its keys are checked by the pattern parser (validate)
     if (!print) throw_input(file, "print", "", "must be a table ([print])");
-    e.pattern = io::pattern_from_toml(*print, file, std::filesystem::path(file).parent_path());
-    if (e.enabled && !user_print) throw_input(file, "print", "", "[electric] enabled = true needs a [print] table (e.g. pattern = \"line\")");
+    c.print = *print;
   }
   {
     auto s = top.sub("output");
@@ -234,6 +232,170 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     s.finish();
   }
   top.finish();
+  return c;
+}
+
+namespace {
+// Writes a number, keeping an integer node an integer while the value is integral (a file's
+// `voltage_V = 40` serializes as written).
+void put(toml::table& t, std::string_view key, double v) {
+  const toml::node* n = t.get(key);
+  if (n && n->is_integer() && std::isfinite(v) && v == std::floor(v) && std::fabs(v) < 9.0e15)
+    t.insert_or_assign(key, static_cast<std::int64_t>(v));
+  else
+    t.insert_or_assign(key, v);
+}
+void put_int(toml::table& t, std::string_view key, std::int64_t v) { t.insert_or_assign(key, v); }
+void put_bool(toml::table& t, std::string_view key, bool v) { t.insert_or_assign(key, v); }
+void put_str(toml::table& t, std::string_view key, const std::string& v) { t.insert_or_assign(key, v); }
+toml::table& sub(toml::table& t, std::string_view key) {
+  if (!t.get(key) || !t.get(key)->is_table()) t.insert_or_assign(key, toml::table{});
+  return *t.get(key)->as_table();
+}
+void put_collision(toml::table& t, const CollisionType& c) {
+  put(t, "restitution", c.restitution);
+  put(t, "k_N_per_m", c.k);
+  put(t, "mu_s", c.mu_s);
+  put(t, "mu_d", c.mu_d);
+}
+
+// Every field under the key the reader reads it from (read_nip_config): the typed fields are
+// the configuration, the table only its serialization. A test checks that writing into an
+// empty table gives every key of the resolved configuration.
+void write_fields(const NipConfig& c, toml::table& root) {
+  put_str(root, "preset", c.preset);
+  {
+    auto& t = sub(root, "run");
+    put_int(t, "seed", static_cast<std::int64_t>(c.seed));
+    put(t, "end_time_s", c.end_time);
+    put(t, "output_interval_s", c.output_interval);
+    put(t, "checkpoint_interval_s", c.checkpoint_interval);
+    put_int(t, "threads", c.threads);
+    put_str(t, "integrator", c.integrator == engine::Integrator::velocity_verlet ? "velocity_verlet" : "newmark_explicit");
+    put(t, "dt_s", c.dt);
+    put(t, "dt_fraction_of_contact_time", c.dt_fraction);
+    put(t, "neighbor_skin_d50", c.list_skin_d50);
+  }
+  {
+    auto& t = sub(root, "geometry");
+    put(t, "gap_m", c.gap);
+    put(t, "drum_radius_m", c.drum_radius);
+    put(t, "roller_radius_m", c.roller_radius);
+    put(t, "drum_surface_speed_m_per_s", c.drum_speed);
+    put(t, "roller_surface_speed_m_per_s", c.roller_speed);
+    put(t, "nip_x_m", c.nip_x);
+    put(t, "window_x_min_m", c.x_min);
+    put(t, "window_x_max_m", c.x_max);
+    auto& r = sub(t, "roughness");
+    put_bool(r, "enabled", c.roughness);
+    put(r, "height_m", c.rough_height);
+    put(r, "base_m", c.rough_base);
+    put(r, "spacing_m", c.rough_spacing);
+  }
+  {
+    auto& t = sub(root, "toner");
+    put(t, "d_small_m", c.size.d_small);
+    put(t, "d50_m", c.size.d50);
+    put(t, "d_large_m", c.size.d_large);
+    put_str(t, "size_weighting", c.size.number_weighted ? "number" : "volume");
+    put(t, "density_kg_per_m3", c.density);
+    put_str(t, "cluster", c.cluster);
+    put_str(t, "cluster_file", c.cluster_file);
+  }
+  {
+    auto& t = sub(root, "collision");
+    put(t, "stiffness_scale", c.stiffness_scale);
+    put_str(t, "damping_convention", c.damping == models::DampingConvention::physical ? "physical" : "thesis");
+    put_collision(sub(t, "toner_toner"), c.tt);
+    put_collision(sub(t, "toner_roller"), c.ti);
+    put_collision(sub(t, "toner_drum"), c.td);
+  }
+  {
+    auto& t = sub(root, "adhesion");
+    put_str(t, "distance", c.adhesion_distance == models::HamakerParams::Distance::surface ? "surface" : "centre");
+    put(t, "min_separation_m", c.min_separation);
+    put(t, "cutoff_m", c.adhesion_cutoff);
+    put(t, "roller_force_N", c.adhesion_roller_force);
+    put(t, "drum_force_N", c.adhesion_drum_force);
+    put(t, "cohesion_ratio", c.cohesion_ratio);
+  }
+  {
+    auto& t = sub(root, "inflow");
+    put(t, "layer_thickness_m", c.layer_thickness);
+    put(t, "area_fraction", c.area_fraction);
+    put_int(t, "interval_steps", c.insert_interval);
+    put_bool(t, "prefill", c.prefill);
+    put_str(t, "roller_pits", c.roller_pits_filled ? "filled" : "empty");
+  }
+  {
+    auto& t = sub(root, "initial_assembly");
+    put_bool(t, "enabled", c.assembly.enabled);
+    put(t, "x_min_m", c.assembly.x_min);
+    put(t, "x_max_m", c.assembly.x_max);
+    put(t, "height_m", c.assembly.height);
+    put(t, "area_fraction", c.assembly.area_fraction);
+  }
+  {
+    auto& t = sub(root, "gravity");
+    toml::array g;
+    const toml::array* old = t["vector_m_per_s2"].as_array();
+    const double v[2] = {c.gravity.x, c.gravity.y};
+    for (int k = 0; k < 2; ++k) {
+      const bool integer = old && old->size() == 2 && (*old)[k].is_integer() && v[k] == std::floor(v[k]) && std::fabs(v[k]) < 9.0e15;
+      if (integer) g.push_back(static_cast<std::int64_t>(v[k]));
+      else g.push_back(v[k]);
+    }
+    t.insert_or_assign("vector_m_per_s2", std::move(g));
+  }
+  {
+    auto& t = sub(root, "magnet");
+    const auto& m = c.magnet;
+    put_str(t, "field", m.field);
+    put_str(t, "map_file", m.map_file);
+    put_str(t, "pigment", c.magnet_pigment);
+    put(t, "saturation_magnetisation_A_per_m", m.toner.Ms_A_per_m);
+    put(t, "saturation_flux_T", m.toner.B_sat_T);
+    put(t, "pigment_volume_fraction", m.toner.eta);
+    put_bool(t, "dipole_dipole", m.dipole_dipole);
+    put(t, "dipole_cutoff_m", m.dipole_cutoff);
+    put(t, "dipole_skin_m", m.dipole_skin);
+    put_int(t, "dipole_interval_steps", m.dipole_interval);
+    put_int(t, "field_interval_steps", m.field_interval);
+  }
+  {
+    auto& t = sub(root, "electric");
+    const auto& e = c.electric;
+    put_bool(t, "enabled", e.enabled);
+    put_str(t, "model", electric::to_string(e.force.model));
+    put(t, "approx_coefficient", e.force.approx_coefficient);
+    put_bool(t, "dielectric_layer", e.dielectric_layer);
+    put(t, "layer_thickness_m", e.layer_thickness);
+    put(t, "layer_permittivity", e.layer_permittivity);
+    put_str(t, "charge_preset", c.charge_preset);
+    put(t, "R_tt_ohm", e.rc.R_tt_ohm);
+    put(t, "R_ti_ohm", e.rc.R_ti_ohm);
+    put(t, "C_td_F", e.rc.C_td_F);
+    put(t, "R_td_ohm", e.rc.R_td_ohm);
+    put(t, "range_m", e.rc.range_m);
+    put(t, "corridor_fraction", e.corridor_fraction);
+    put_int(t, "path_interval_steps", e.path_interval);
+  }
+  root.insert_or_assign("print", c.print);
+  put_bool(sub(root, "output"), "vtk", c.vtk);
+}
+}  // namespace
+
+void validate(NipConfig& c) {
+  const std::string& file = c.file;
+  {
+    auto& e = c.electric;
+    e.pattern = io::pattern_from_toml(c.print, file, std::filesystem::path(file).parent_path());
+    if (e.enabled && !c.print_given) throw_input(file, "print", "", "[electric] enabled = true needs a [print] table (e.g. pattern = \"line\")");
+    e.drum_speed = c.drum_speed;
+    e.drum_centre = {c.nip_x, c.gap + c.drum_radius};
+    e.drum_radius = c.drum_radius;
+  }
+  if (c.magnet.field != "none") make_magnet_field(c.magnet);  // reject a bad map now, naming the file
 
   // Cross-checks.
   if (c.gap <= c.size.d_max())
@@ -257,7 +419,8 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
     // config.toml of a run folder must work from there: file names become absolute (a pattern
     // file is relative to the config's folder, a cluster or map file to the working folder).
     // The resume key keeps the names as given.
-    toml::table resolved = root;
+    write_fields(c, c.table);
+    toml::table resolved = c.table;
     auto absolute = [](toml::table* t, const char* key, const std::filesystem::path& base) {
       if (!t) return;
       const auto v = (*t)[key].value<std::string>();
@@ -274,6 +437,7 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   }
   // A resumed run may extend the end time and change the output cadence; nothing else
   // (e.g. the thread count changes the floating-point summation order).
+  toml::table root = c.table;
   if (auto* run = root["run"].as_table()) {
     run->erase("end_time_s");
     run->erase("output_interval_s");
@@ -287,11 +451,25 @@ NipConfig parse_nip_config(const std::string& text, const std::string& file, con
   pk << root;
   c.prefix_key = pk.str();
   check_resource_bounds(c, choose_time_step(c));  // refuses a time step above the stability bound
+}
+
+NipConfig parse_nip_config(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+  NipConfig c = read_nip_config(text, file, overrides);
+  validate(c);
   return c;
 }
 
 NipConfig load_nip_config(const std::string& path, const std::vector<std::string>& overrides) {
   return parse_nip_config(io::read_file(path), path, overrides);
+}
+
+void set_print_line(NipConfig& c, double start_m, double length_m, std::optional<double> voltage_V) {
+  c.electric.enabled = true;
+  c.print_given = true;
+  c.print.insert_or_assign("pattern", "line");
+  if (voltage_V) c.print.insert_or_assign("voltage_V", *voltage_V);
+  c.print.insert_or_assign("start_m", start_m);
+  c.print.insert_or_assign("length_m", length_m);
 }
 
 double toner_mass(const NipConfig& c, double d) { return c.density * pi * d * d * d / 6.0; }

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/toner.hpp"
+#include "nipdem/nip/toner.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/nip.hpp"
+#include "nipdem/nip/nip.hpp"
 
 #include <cmath>
 #include <limits>
@@ -9,7 +9,7 @@
 #include "nipdem/core/binary_io.hpp"
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/nip/nip_forces.hpp"
 #include "nipdem/io/checkpoint_file.hpp"
 #include "nipdem/geometry/walls.hpp"
 

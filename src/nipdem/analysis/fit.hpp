@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,16 +28,39 @@ namespace nipdem::analysis {
 // 2 ln 9: 10–90 % width of a logistic of scale w is kLogistic1090 * |w|.
 inline constexpr double kLogistic1090 = 4.394449154672439;
 
-// ---- Generic Levenberg–Marquardt ---------------------------------------------------------
+// ---- Levenberg–Marquardt: the one fitter of nipdem ------------------------------------------
+// Used by the sigmoid fits below, the adhesion and magnetisation calibrations and the probe-
+// circuit fit (calibrate_rc, with fixed parameters, a search box and a step cap).
 // `model(p, r, J)` fills residuals r (size n) and Jacobian J = dr/dp (n x m).
 using LmModel = std::function<void(const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J)>;
 struct LmResult {
   Eigen::VectorXd p;
   Eigen::MatrixXd covariance;  // (J^T J)^-1 * rss / (n - m): parameter covariance estimate
   double rss = 0;              // sum of squared residuals
-  int iterations = 0;
+  int iterations = 0;          // iterations run
   bool converged = false;
 };
+struct LmOptions {
+  int max_iterations = 200;
+  // When an accepted step ends the fit:
+  //  relative: rss drop <= tol_drop * rss before the step, rss = 0, or the step, measured in
+  //            the metric of the curvature, <= tol_step * sqrt(rss) (scale-free across parameters);
+  //  absolute: rss drop <= tol_drop * rss after the step + 1e-300, or max |change of p| < tol_step.
+  enum class Stop { relative, absolute } stop = Stop::relative;
+  double tol_drop = 1e-10;
+  double tol_step = 1e-8;
+  std::vector<bool> free;          // empty: every parameter free; a fixed one keeps its start value
+  Eigen::VectorXd lower, upper;    // empty: no bounds; trial points are clamped into the box
+  double max_step = std::numeric_limits<double>::infinity();  // largest |step| of one parameter
+  // Damping of each parameter: lambda * max(its curvature, damping_floor * the largest one).
+  double damping_floor = 0.0;
+  bool strict_decrease = false;    // accept a step that lowers the rss (false: that does not raise it)
+  // A fit with no downhill step left is at a minimum: the damping above lambda_cap, or
+  // max_tries rejected steps in one iteration (0: no limit).
+  double lambda_cap = 1e14;
+  int max_tries = 0;
+};
+LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size_t n_residuals, const LmOptions& opt);
 LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size_t n_residuals,
                              int max_iterations = 200, double rel_tol = 1e-10);
 

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_vo.hpp"
+#include "nipdem/analysis/vo.hpp"
 
 #include <cmath>
 #include <fmt/format.h>

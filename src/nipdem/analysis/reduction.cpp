@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_reduction.hpp"
+#include "nipdem/analysis/reduction.hpp"
 
 #include <algorithm>
 #include <cmath>

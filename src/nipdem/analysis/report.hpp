@@ -7,10 +7,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/analysis_fit.hpp"
-#include "nipdem/experiments/analysis_reduction.hpp"
-#include "nipdem/experiments/analysis_steady.hpp"
-#include "nipdem/experiments/analysis_vo.hpp"
+#include "nipdem/analysis/fit.hpp"
+#include "nipdem/analysis/reduction.hpp"
+#include "nipdem/analysis/steady.hpp"
+#include "nipdem/analysis/vo.hpp"
 #include "nipdem/io/plot.hpp"
 
 namespace nipdem::analysis {

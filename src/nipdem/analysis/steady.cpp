@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_steady.hpp"
+#include "nipdem/analysis/steady.hpp"
 
 #include <cmath>
 #include <fmt/format.h>

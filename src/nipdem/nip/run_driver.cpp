@@ -1,4 +1,4 @@
-#include "nipdem/experiments/run_driver.hpp"
+#include "nipdem/nip/run_driver.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -9,6 +9,7 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/wait_policy.hpp"
 #include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/csv.hpp"
 #include "nipdem/io/progress.hpp"
 #include "nipdem/io/vtk.hpp"
 #include "nipdem/version.hpp"
@@ -22,11 +23,18 @@ namespace {
 const char* exit_name(Exit e) { return e == Exit::developed ? "developed" : e == Exit::returned ? "returned" : "lost"; }
 
 std::string removals_csv(const NipRun& run) {
-  std::string s = "time_s,exit,x_m,y_m,diameter_m,body_id\n";
+  std::vector<std::vector<std::string>> rows;
   for (const auto& e : run.removals())
-    s += fmt::format("{:.9g},{},{:.9g},{:.9g},{:.6g},{}\n", e.time, exit_name(e.where), e.x, e.y, e.size, e.id);
-  return s;
+    rows.push_back({fmt::format("{:.9g}", e.time), exit_name(e.where), fmt::format("{:.9g}", e.x), fmt::format("{:.9g}", e.y),
+                    fmt::format("{:.6g}", e.size), fmt::format("{}", e.id)});
+  return io::format_csv_cells({"time_s", "exit", "x_m", "y_m", "diameter_m", "body_id"}, rows);
 }
+
+// timeseries.csv: one row per snapshot (it grows row by row and is cut back on resume).
+const std::vector<std::string> kSeriesColumns = {"time_s", "bodies", "discs", "inserted", "developed", "returned", "lost", "contacts",
+                                                 "kinetic_energy_J", "drum_voltage_V", "printable", "charged_over_1V", "max_voltage_V"};
+const std::vector<std::string> kSeriesFormats = {"{:.9g}", "{:.0f}", "{:.0f}", "{:.0f}", "{:.0f}", "{:.0f}", "{:.0f}", "{:.0f}",
+                                                 "{:.6g}", "{:g}", "{:.0f}", "{:.0f}", "{:.4g}"};
 // Temp files "<name>.tmp.<pid>" of a writer that no longer runs (killed between the write and
 // the rename of write_file_atomic): removed, so a killed run leaves nothing behind after the next.
 void remove_stale_temp_files(const fs::path& out) {
@@ -73,7 +81,7 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
   }
   NipRun run(cfg);
   std::vector<std::pair<double, std::string>> frames;
-  std::string series = "time_s,bodies,discs,inserted,developed,returned,lost,contacts,kinetic_energy_J,drum_voltage_V,printable,charged_over_1V,max_voltage_V\n";
+  std::string series = io::format_csv_header(kSeriesColumns);
   const double dt = run.time_step().dt;
   if (opt.resume) {
     run.restore(io::read_file(ckpt, io::kMaxCheckpointBytes), ckpt.string());
@@ -136,20 +144,22 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
       printable = e->printable_count();
       for (double u : e->voltage()) { vmax = std::max(vmax, std::fabs(u)); charged += std::fabs(u) > 1.0; }
     }
-    series += fmt::format("{:.9g},{},{},{},{},{},{},{},{:.6g},{:g},{},{},{:.4g}\n", sim.time(), sim.bodies().x.size(), sim.discs().x.size(),
-                          run.inserted(), run.removed(Exit::developed), run.removed(Exit::returned), run.removed(Exit::lost),
-                          sim.contacts(), sim.energy().kinetic, vd, printable, charged, vmax);
+    auto count = [](auto n) { return static_cast<double>(n); };
+    series += io::format_csv_row({sim.time(), count(sim.bodies().x.size()), count(sim.discs().x.size()), count(run.inserted()),
+                                  count(run.removed(Exit::developed)), count(run.removed(Exit::returned)), count(run.removed(Exit::lost)),
+                                  count(sim.contacts()), sim.energy().kinetic, vd, count(printable), count(charged), vmax},
+                                 kSeriesFormats);
     io::write_file_atomic(out / "timeseries.csv", series);
   };
   auto save_checkpoint = [&] {
     io::write_file_atomic(ckpt, run.checkpoint());
     io::write_file_atomic(out / "removals.csv", removals_csv(run));
     if (cfg.electric.enabled) {
-      std::string cov = "s_begin_m,s_end_m,coverage,particles,track_voltage_V\n";
+      std::vector<std::vector<double>> cov;
       for (const auto& b : run.coverage(0.25 * cfg.size.d50))
-        cov += fmt::format("{:.9g},{:.9g},{},{},{:g}\n", b.s0, b.s1, b.covered ? 1 : 0, b.particles,
-                           cfg.electric.pattern.voltage_at(0.5 * (b.s0 + b.s1)));
-      io::write_file_atomic(out / "coverage.csv", cov);
+        cov.push_back({b.s0, b.s1, b.covered ? 1.0 : 0.0, static_cast<double>(b.particles), cfg.electric.pattern.voltage_at(0.5 * (b.s0 + b.s1))});
+      io::write_csv(out / "coverage.csv", {"s_begin_m", "s_end_m", "coverage", "particles", "track_voltage_V"}, cov,
+                    {"{:.9g}", "{:.9g}", "{:.0f}", "{:.0f}", "{:g}"});
     }
   };
 

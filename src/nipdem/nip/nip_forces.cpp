@@ -1,4 +1,4 @@
-#include "nipdem/experiments/nip_forces.hpp"
+#include "nipdem/nip/nip_forces.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "nipdem/experiments/analysis_fit.hpp"
+#include "nipdem/analysis/fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -107,9 +107,10 @@ EdgeFit make_edge(double x0, double w, double floor, double ceiling, double var_
 
 }  // namespace
 
-LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size_t n, int max_iterations,
-                             double rel_tol) {
+LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size_t n, const LmOptions& opt) {
   const Eigen::Index m = p0.size();
+  const bool bounded = opt.lower.size() == m && opt.upper.size() == m;
+  auto is_free = [&](Eigen::Index k) { return opt.free.empty() || opt.free[static_cast<std::size_t>(k)]; };
   LmResult res;
   Eigen::VectorXd r(n), r_new(n);
   Eigen::MatrixXd J(n, m), J_new(n, m);
@@ -117,54 +118,76 @@ LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size
   model(p, r, J);
   double rss = r.squaredNorm();
   double lambda = 1e-3;
-  int it = 0;
   bool converged = false;
-  for (; it < max_iterations; ++it) {
+  int it = 0;
+  for (; it < opt.max_iterations && !converged; ++it) {
     const Eigen::MatrixXd JtJ = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * r;
-    Eigen::VectorXd d = JtJ.diagonal().cwiseMax(1e-300);
-    bool accepted = false;
-    while (!accepted) {
+    Eigen::VectorXd g = J.transpose() * r;
+    const double floor = opt.damping_floor > 0.0 ? opt.damping_floor * std::max(JtJ.diagonal().maxCoeff(), 1e-300) : 1e-300;
+    const Eigen::VectorXd d = JtJ.diagonal().cwiseMax(floor);
+    for (Eigen::Index k = 0; k < m; ++k)
+      if (!is_free(k)) g[k] = 0.0;
+    for (int tries = 1;; ++tries) {
       Eigen::MatrixXd A = JtJ;
-      A.diagonal() += lambda * d;
-      const Eigen::VectorXd step = A.ldlt().solve(-g);
-      const Eigen::VectorXd p_new = p + step;
+      for (Eigen::Index k = 0; k < m; ++k) {
+        if (is_free(k)) {
+          A(k, k) += lambda * d[k];
+        } else {  // a fixed parameter: its row and column decouple, its step is 0
+          A.row(k).setZero();
+          A.col(k).setZero();
+          A(k, k) = 1.0;
+        }
+      }
+      Eigen::VectorXd step = A.ldlt().solve(-g);
       if (!step.allFinite()) {
         lambda *= 10;
       } else {
+        const double big = step.cwiseAbs().maxCoeff();
+        if (big > opt.max_step) step *= opt.max_step / big;
+        Eigen::VectorXd p_new = p + step;
+        if (bounded) p_new = p_new.cwiseMax(opt.lower).cwiseMin(opt.upper);
         model(p_new, r_new, J_new);
         const double rss_new = r_new.allFinite() ? r_new.squaredNorm() : std::numeric_limits<double>::infinity();
-        if (rss_new <= rss) {
+        if (opt.strict_decrease ? rss_new < rss : rss_new <= rss) {
           const double drop = rss - rss_new;
+          if (opt.stop == LmOptions::Stop::relative) {
+            const double step_norm = std::sqrt((step.array().square() * d.array()).sum());
+            const double fit_norm = std::sqrt(std::max(rss_new, 1e-300));
+            converged = drop <= opt.tol_drop * rss || rss_new == 0.0 || step_norm <= opt.tol_step * fit_norm;
+          } else {
+            const double change = (p_new - p).cwiseAbs().maxCoeff();
+            converged = drop <= opt.tol_drop * rss_new + 1e-300 || change < opt.tol_step;
+          }
           p = p_new;
           r.swap(r_new);
           J.swap(J_new);
-          accepted = true;
-          lambda = std::max(lambda / 3.0, 1e-12);
-          // Relative step size in the metric of the curvature (scale-free across parameters).
-          const double step_norm = std::sqrt((step.array().square() * d.array()).sum());
-          const double fit_norm = std::sqrt(std::max(rss_new, 1e-300));
-          if (drop <= rel_tol * rss || rss_new == 0.0 || step_norm <= 1e-8 * fit_norm) converged = true;
           rss = rss_new;
+          lambda = std::max(lambda / 3.0, 1e-12);
           break;
         }
         lambda *= 4.0;
       }
-      if (lambda > 1e14) {  // no downhill step left: at a minimum to machine precision
+      if (lambda > opt.lambda_cap || (opt.max_tries > 0 && tries >= opt.max_tries)) {  // no downhill step left
         converged = true;
         break;
       }
     }
-    if (converged) break;
   }
   res.p = p;
   res.rss = rss;
-  res.iterations = it + 1;
+  res.iterations = it;
   res.converged = converged;
   const double dof = static_cast<double>(n) - static_cast<double>(m);
   const Eigen::MatrixXd JtJ = J.transpose() * J;
   res.covariance = JtJ.completeOrthogonalDecomposition().pseudoInverse() * (dof > 0 ? rss / dof : 0.0);
   return res;
+}
+
+LmResult levenberg_marquardt(const LmModel& model, Eigen::VectorXd p0, std::size_t n, int max_iterations, double rel_tol) {
+  LmOptions o;
+  o.max_iterations = max_iterations;
+  o.tol_drop = rel_tol;
+  return levenberg_marquardt(model, std::move(p0), n, o);
 }
 
 EdgeFit fit_edge(const std::vector<double>& x_in, const std::vector<double>& c_in, const SigmoidOptions& opt) {

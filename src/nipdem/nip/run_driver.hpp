@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "nipdem/experiments/nip.hpp"
+#include "nipdem/nip/nip.hpp"
 
 namespace nipdem::experiments {
 
