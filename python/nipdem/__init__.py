@@ -406,11 +406,25 @@ def _read_csv(path):
     out = {}
     for j, name in enumerate(names):
         col = [r[j] if j < len(r) else "" for r in rows]
-        try:
-            out[name] = _np.array([float(v) if v != "" else _math.nan for v in col])
-        except ValueError:
-            out[name] = _np.array(col)
+        out[name] = _column(col)
     return out
+
+
+def _column(col):
+    """Integers (counts, ids, 64-bit seeds) stay exact integers; other numbers are floats
+    (empty = NaN); anything else stays text."""
+    try:
+        ints = [int(v) for v in col]
+        if all(-2**63 <= v < 2**63 for v in ints):
+            return _np.array(ints, dtype=_np.int64)
+        if all(0 <= v < 2**64 for v in ints):
+            return _np.array(ints, dtype=_np.uint64)
+    except ValueError:
+        pass
+    try:
+        return _np.array([float(v) if v != "" else _math.nan for v in col])
+    except ValueError:
+        return _np.array(col)
 
 
 def read_run(folder):
