@@ -132,7 +132,7 @@ class Config:
         self.set(key, value)
 
     def set(self, key, value):
-        """Sets one key; `value` a Python value or, if `raw`, see set_raw."""
+        """Sets one key to a Python value (bool, int, float, str, or a list of them)."""
         self.set_raw(key, _toml_literal(value))
 
     def set_raw(self, key, literal):
@@ -281,6 +281,11 @@ _DISC_ARRAYS = ("x", "y", "r", "body", "ox", "oy", "fx", "fy", "torque", "fx_adh
 
 class Simulation:
     """A nip simulation of a Config (or a config file / preset name), as `nipdem run` makes it.
+
+    advance/advance_to/step release the GIL; while one runs, any other call on the same
+    Simulation from another thread raises RuntimeError (busy) instead of racing. Ctrl-C stops
+    a simulation advancing in the main thread (KeyboardInterrupt, at an insert-interval
+    boundary; the run can go on).
 
     Arrays: ``sim.bodies.<name>`` and ``sim.discs.<name>`` are read-only NumPy *views* of the
     engine's arrays (no copy); each keeps the simulation alive, but is valid only until the

@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <exception>
@@ -101,6 +102,27 @@ py::array disc_array(const Simulation& s, const std::string& name, py::handle ow
                            "' (allowed: x, y, r, body, ox, oy, fx, fy, torque, fx_adhesion, fy_adhesion)");
 }
 
+// One Simulation must not run in two threads at once, nor be read while it runs (its arrays
+// change under the reader): calls that release the GIL hold its busy flag, and every other
+// call checks it, raising RuntimeError instead of racing.
+class Busy {
+ public:
+  explicit Busy(const Simulation& s) : flag_(s.busy()) {
+    if (flag_.exchange(true)) throw std::runtime_error(kMessage);
+  }
+  ~Busy() { flag_ = false; }
+  Busy(const Busy&) = delete;
+  Busy& operator=(const Busy&) = delete;
+  static const Simulation& check(const Simulation& s) {
+    if (s.busy()) throw std::runtime_error(kMessage);
+    return s;
+  }
+
+ private:
+  static constexpr const char* kMessage = "nipdem.Simulation: busy in another thread (advance, step, checkpoint or restore)";
+  std::atomic<bool>& flag_;
+};
+
 const char* exit_name(nipdem::experiments::Exit e) {
   using nipdem::experiments::Exit;
   return e == Exit::developed ? "developed" : e == Exit::returned ? "returned" : "lost";
@@ -169,6 +191,7 @@ PYBIND11_MODULE(_nipdem, m) {
       .def(
           "advance_to",
           [](Simulation& s, double t_end) {
+            Busy busy(s);
             InterruptPoll poll;
             py::gil_scoped_release release;
             s.advance_to(t_end, std::ref(poll));
@@ -178,31 +201,32 @@ PYBIND11_MODULE(_nipdem, m) {
           "step",
           [](Simulation& s, std::int64_t n) {
             if (n < 0) throw nipdem::InputError("Simulation.step: n = " + std::to_string(n) + ": must be >= 0");
+            Busy busy(s);
             InterruptPoll poll;
             py::gil_scoped_release release;
             s.step(n, std::ref(poll));
           },
           py::arg("n"))
-      .def_property_readonly("time", [](const Simulation& s) { return s.run().sim().time(); })
-      .def_property_readonly("step_count", [](const Simulation& s) { return s.run().sim().step_count(); })
-      .def_property_readonly("dt", [](const Simulation& s) { return s.run().time_step().dt; })
-      .def_property_readonly("dt_bound", [](const Simulation& s) { return s.run().time_step().bound; })
-      .def_property_readonly("insert_interval", [](const Simulation& s) { return s.run().config().insert_interval; })
-      .def_property_readonly("n_bodies", [](const Simulation& s) { return s.run().sim().bodies().x.size(); })
-      .def_property_readonly("n_discs", [](const Simulation& s) { return s.run().sim().discs().x.size(); })
-      .def_property_readonly("contacts", [](const Simulation& s) { return s.run().sim().contacts(); })
-      .def_property_readonly("inserted", [](const Simulation& s) { return s.run().inserted(); })
-      .def_property_readonly("inserted_in_roller_pits", [](const Simulation& s) { return s.run().inserted_on_roller(); })
+      .def_property_readonly("time", [](const Simulation& s) { return Busy::check(s).run().sim().time(); })
+      .def_property_readonly("step_count", [](const Simulation& s) { return Busy::check(s).run().sim().step_count(); })
+      .def_property_readonly("dt", [](const Simulation& s) { return Busy::check(s).run().time_step().dt; })
+      .def_property_readonly("dt_bound", [](const Simulation& s) { return Busy::check(s).run().time_step().bound; })
+      .def_property_readonly("insert_interval", [](const Simulation& s) { return Busy::check(s).run().config().insert_interval; })
+      .def_property_readonly("n_bodies", [](const Simulation& s) { return Busy::check(s).run().sim().bodies().x.size(); })
+      .def_property_readonly("n_discs", [](const Simulation& s) { return Busy::check(s).run().sim().discs().x.size(); })
+      .def_property_readonly("contacts", [](const Simulation& s) { return Busy::check(s).run().sim().contacts(); })
+      .def_property_readonly("inserted", [](const Simulation& s) { return Busy::check(s).run().inserted(); })
+      .def_property_readonly("inserted_in_roller_pits", [](const Simulation& s) { return Busy::check(s).run().inserted_on_roller(); })
       .def_property_readonly("removed",
                              [](const Simulation& s) {
                                using nipdem::experiments::Exit;
                                py::dict d;
-                               for (Exit e : {Exit::developed, Exit::returned, Exit::lost}) d[exit_name(e)] = s.run().removed(e);
+                               for (Exit e : {Exit::developed, Exit::returned, Exit::lost}) d[exit_name(e)] = Busy::check(s).run().removed(e);
                                return d;
                              })
       .def("energy",
            [](const Simulation& s) {
-             const auto e = s.run().sim().energy();
+             const auto e = Busy::check(s).run().sim().energy();
              py::dict d;
              d["kinetic_J"] = e.kinetic;
              d["elastic_J"] = e.elastic;
@@ -211,40 +235,43 @@ PYBIND11_MODULE(_nipdem, m) {
              return d;
            })
       .def(
-          "body_array", [](py::object self, const std::string& name) { return body_array(self.cast<const Simulation&>(), name, self); },
+          "body_array", [](py::object self, const std::string& name) { return body_array(Busy::check(self.cast<const Simulation&>()), name, self); },
           py::arg("name"))
       .def(
-          "disc_array", [](py::object self, const std::string& name) { return disc_array(self.cast<const Simulation&>(), name, self); },
+          "disc_array", [](py::object self, const std::string& name) { return disc_array(Busy::check(self.cast<const Simulation&>()), name, self); },
           py::arg("name"))
       .def("provider_names",
            [](const Simulation& s) {
              std::vector<std::string> n;
-             for (const auto& f : s.run().sim().forces()) n.push_back(f->name());
+             for (const auto& f : Busy::check(s).run().sim().forces()) n.push_back(f->name());
              return n;
            })
       .def(
           "provider_force",
           [](py::object self, std::size_t k) {
-            const auto& sim = self.cast<const Simulation&>().run().sim();
+            const auto& sim = Busy::check(self.cast<const Simulation&>()).run().sim();
             if (k >= sim.forces().size())
               throw nipdem::InputError("Simulation.provider_force: index " + std::to_string(k) + " out of range [0, " +
                                        std::to_string(sim.forces().size()) + ")");
             return py::make_tuple(view(sim.provider_fx(k), self), view(sim.provider_fy(k), self));
           },
           py::arg("k"))
-      .def("voltages", [](const Simulation& s) { return copy(s.voltages()); })
+      .def("voltages", [](const Simulation& s) { return copy(Busy::check(s).voltages()); })
       // the charge model's own vector, in the order of its last evaluation (tests only)
       .def("_voltages_as_stored",
-           [](const Simulation& s) { return s.run().electric() ? copy(s.run().electric()->voltage()) : copy(std::vector<double>{}); })
+           [](const Simulation& s) {
+             const auto* e = Busy::check(s).run().electric();
+             return e ? copy(e->voltage()) : copy(std::vector<double>{});
+           })
       .def_property_readonly("drum_capacity_F",
-                             [](const Simulation& s) { return s.run().config().electric.rc.C_td_F; })
-      .def_property_readonly("electric_enabled", [](const Simulation& s) { return s.run().electric() != nullptr; })
+                             [](const Simulation& s) { return Busy::check(s).run().config().electric.rc.C_td_F; })
+      .def_property_readonly("electric_enabled", [](const Simulation& s) { return Busy::check(s).run().electric() != nullptr; })
       .def(
-          "assembly_x", [](const Simulation& s, double max_h, double min_h) { return copy(s.run().assembly_x(max_h, min_h)); },
+          "assembly_x", [](const Simulation& s, double max_h, double min_h) { return copy(Busy::check(s).run().assembly_x(max_h, min_h)); },
           py::arg("max_height"), py::arg("min_height") = -1.0)
       .def("removals",
            [](const Simulation& s) {
-             const auto& r = s.run().removals();
+             const auto& r = Busy::check(s).run().removals();
              std::vector<double> t, x, y, size;
              std::vector<std::int64_t> id;
              std::vector<std::int32_t> where;
@@ -261,10 +288,11 @@ PYBIND11_MODULE(_nipdem, m) {
              d["body_id"] = copy(id);
              return d;
            })
-      .def("describe", [](const Simulation& s) { return s.run().describe().dump(); })
-      .def("resolved_toml", [](const Simulation& s) { return s.run().config().resolved_toml; })
+      .def("describe", [](const Simulation& s) { return Busy::check(s).run().describe().dump(); })
+      .def("resolved_toml", [](const Simulation& s) { return Busy::check(s).run().config().resolved_toml; })
       .def("checkpoint",
            [](const Simulation& s) {
+             Busy busy(s);
              std::string blob;
              {
                py::gil_scoped_release release;
@@ -275,6 +303,7 @@ PYBIND11_MODULE(_nipdem, m) {
       .def(
           "restore",
           [](Simulation& s, py::bytes blob, const std::string& where) {
+            Busy busy(s);
             std::string b = blob;
             py::gil_scoped_release release;
             s.restore(b, where);

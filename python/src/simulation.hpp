@@ -9,6 +9,7 @@
 // voltages() can give them in the order of the current body arrays. tests/python checks that a
 // run driven from here is bit for bit the run `nipdem run` makes (same checkpoint bytes).
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -41,6 +42,9 @@ class Simulation {
   // restore until the next step (a checkpoint does not say which bodies they belong to).
   std::vector<double> voltages() const;
 
+  // Set while a call runs with the GIL released (python/src/bindings.cpp).
+  std::atomic<bool>& busy() const { return busy_; }
+
   experiments::NipRun& run() { return *run_; }
   const experiments::NipRun& run() const { return *run_; }
 
@@ -54,6 +58,7 @@ class Simulation {
   std::vector<std::int64_t> eval_ids_;
   bool eval_ids_valid_ = false;
   bool voltages_unknown_ = false;
+  mutable std::atomic<bool> busy_{false};
 };
 
 }  // namespace nipdem::python

@@ -211,3 +211,21 @@ def test_invalid_config_and_io_errors(tmp_path, small_config):
     assert os.listdir(tmp_path) == ["ckpt"]
     with pytest.raises(ValueError):
         sim.bodies.no_such_array
+
+
+def test_a_running_simulation_refuses_other_threads(small_config):
+    sim = nipdem.Simulation(small_config)
+    worker = threading.Thread(target=lambda: sim.advance_to(3e-4))
+    worker.start()
+    busy = None
+    while worker.is_alive() and busy is None:
+        try:
+            sim.bodies.x  # would read arrays the engine is changing
+        except RuntimeError as e:
+            busy = str(e)
+    assert busy and "busy in another thread" in busy
+    with pytest.raises(RuntimeError):
+        sim.step(1)  # would run the engine from two threads (the worker has ~1 s to go)
+    worker.join()
+    assert sim.time == pytest.approx(3e-4, abs=0.5 * sim.dt)  # the worker's run was not disturbed
+    assert sim.bodies.x.shape == (sim.n_bodies,)             # and afterwards everything works
