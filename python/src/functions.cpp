@@ -1,0 +1,370 @@
+#include "functions.hpp"
+
+#include <cmath>
+#include <limits>
+#include <type_traits>
+#include <memory>
+#include <set>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "nipdem/core/constants.hpp"
+#include "nipdem/core/error.hpp"
+#include "nipdem/experiments/nip_config.hpp"
+#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/io/atomic_file.hpp"
+#include "nipdem/io/field_map.hpp"
+#include "nipdem/models/dipole.hpp"
+#include "nipdem/models/dipole_pigments.hpp"
+#include "nipdem/models/electric_force.hpp"
+#include "nipdem/models/magnet_field.hpp"
+#include "nipdem/models/probe_circuit.hpp"
+#include "nipdem/solvers/ldc/verify.hpp"
+
+namespace nipdem::python {
+
+using nlohmann::json;
+
+std::string collision_params(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
+  using namespace experiments;
+  const NipConfig cfg = parse_nip_config(text, file, overrides);
+  const auto ts = choose_time_step(cfg);
+  json j;
+  for (const auto& r : collision_report(cfg)) {
+    j[r.name] = {{"k_N_per_m", r.k}, {"gamma_Ns_per_m", r.gamma}, {"ks_N_per_m", r.ks}, {"restitution", r.restitution},
+                 {"contact_time_s", r.contact_time}, {"dt_max_s", r.dt_max_newmark}, {"dt_max_verlet_s", r.dt_max_verlet},
+                 {"gamma_thesis_convention_Ns_per_m", r.gamma_thesis}, {"reduced_mass_kg", r.m_red}};
+  }
+  j["stiffness_scale"] = cfg.stiffness_scale;
+  j["dt_s"] = ts.dt;
+  j["dt_bound_s"] = ts.bound;
+  j["dt_limited_by"] = ts.limiting;
+  return j.dump();
+}
+
+ElectricArgs::ElectricArgs()
+    : approx_coefficient(electric::kThesisApproxCoefficient),
+      layer_thickness(electric::kSiOxThickness_m),
+      layer_permittivity(electric::kSiOxPermittivity) {}
+
+std::string force_electric(const ElectricArgs& a) {
+  using namespace electric;
+  ElectricForceParams p;
+  p.model = parse_force_model(a.model, "force electric", "--model");
+  p.approx_coefficient = a.approx_coefficient;
+  p.validate();
+  require_range("force electric", "--radius", a.radius, 1e-9, 1e-2);
+  require_range("force electric", "--gap", a.gap, 1e-12, 1.0);
+  require_range("force electric", "--voltage", a.voltage, -1e6, 1e6);
+  const double d = a.dielectric_layer ? effective_gap(a.gap, a.layer_thickness, a.layer_permittivity) : a.gap;
+  const double F = force(p, a.radius, a.voltage, d);
+  const double Fexact = force_exact(a.radius, a.voltage, d);
+  if (!std::isfinite(F) || !std::isfinite(Fexact))
+    throw_input("force electric", "--radius, --gap, --voltage", fmt::format("{:g} m, {:g} m, {:g} V", a.radius, a.gap, a.voltage),
+                "the force is not representable for these inputs");
+  json j;
+  j["force_N"] = F;
+  j["model"] = to_string(p.model);
+  j["radius_m"] = a.radius;
+  j["voltage_V"] = a.voltage;
+  j["gap_m"] = a.gap;
+  j["effective_gap_m"] = d;
+  j["gap_over_radius"] = d / a.radius;
+  j["force_exact_N"] = Fexact;
+  j["force_small_gap_limit_N"] = force_small_gap_asymptote(a.radius, a.voltage, d, true);
+  j["capacitance_F"] = sphere_plane_capacitance(a.radius, d);
+  return j.dump();
+}
+
+std::string force_dipole(const DipoleArgs& a) {
+  require_range("force dipole", "--moment", a.moment, -1e-3, 1e-3);
+  require_range("force dipole", "--distance", a.distance, 1e-9, 1.0);
+  require_range("force dipole", "--radius", a.radius, 1e-9, 1e-2);
+  dipole::PigmentStudyParams p;
+  p.moment_Am2 = a.moment;
+  p.distance_m = a.distance;
+  p.angle_rad = a.angle_deg * constants::pi / 180.0;
+  p.radius_m = a.radius;
+  p.pigments = a.pigments;
+  p.samples = a.samples;
+  p.seed = a.seed;
+  const auto r = dipole::pigment_study(p);
+  const Vec2 m{a.moment * std::cos(p.angle_rad), a.moment * std::sin(p.angle_rad)};
+  const double cherry = norm(dipole::dipole_force(m, m, {a.distance, 0.0}));
+  if (!std::isfinite(cherry) || !std::isfinite(r.force_mean_vec_abs_N))
+    throw_input("force dipole", "--moment, --distance", fmt::format("{:g} A m^2, {:g} m", a.moment, a.distance),
+                "the force is not representable for these inputs");
+  json j{{"moment_Am2", a.moment},
+         {"distance_m", a.distance},
+         {"angle_deg", a.angle_deg},
+         {"radius_m", a.radius},
+         {"pigments", a.pigments},
+         {"samples", r.samples},
+         {"seed", a.seed},
+         {"force_N", r.force_mean_vec_abs_N},
+         {"force_mean_abs_N", r.force_mean_abs_N},
+         {"force_mean_vector_N", {r.force_mean_N.x, r.force_mean_N.y, r.force_mean_N.z}},
+         {"force_mean_vector_abs_N", r.force_mean_vec_abs_N},
+         {"cherry_pit_force_N", cherry}};
+  if (a.pigments > 1) {
+    j["force_std_N"] = r.force_std_N;
+    j["force_vector_std_N"] = {r.force_vec_std_N.x, r.force_vec_std_N.y, r.force_vec_std_N.z};
+    j["force_sem_N"] = std::hypot(r.force_vec_std_N.x, r.force_vec_std_N.y, r.force_vec_std_N.z) / std::sqrt(static_cast<double>(r.samples));
+  }
+  return j.dump();
+}
+
+namespace {
+// apps/cli/cmd_field.cpp's check_common and make_setup: the field of a preset, a map, or the
+// preset's magnet with tip depth / Br changed; the toner and its radius.
+struct Setup {
+  std::unique_ptr<magnet::MagnetField> field;
+  magnet::MagnetisationParams toner;
+  double radius;
+};
+void check_common(const FieldArgs& c, const std::string& where) {
+  if (c.preset != "black" && c.preset != "color") throw_input(where, "--preset", c.preset, "unknown preset", "black, color");
+  if (c.radius) require_range(where, "--radius", *c.radius, 1e-7, 1e-3);
+  if (c.tip_depth) require_range(where, "--tip-depth", *c.tip_depth, 0.0, 5e-3);
+  if (c.br) require_range(where, "--br", *c.br, -2.5, 2.5);
+}
+Setup make_setup(const FieldArgs& c) {
+  Setup s;
+  s.toner = magnet::preset_toner(c.preset);
+  s.radius = c.radius.value_or(0.0) == 0.0 ? magnet::preset_d50_radius(c.preset) : *c.radius;
+  require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
+  const bool custom = c.tip_depth || c.br;
+  if (!c.map.empty()) {
+    if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
+    s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
+  } else if (custom && c.preset == "black") {
+    magnet::KnifeParams k;
+    if (c.tip_depth) k.tip_depth_m = *c.tip_depth;
+    if (c.br) k.blade_Br_T = *c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
+  } else if (custom && c.preset == "color") {
+    magnet::ColorPoleParams k;
+    if (c.tip_depth) k.tip_depth_m = *c.tip_depth;
+    if (c.br) k.Br_T = *c.br;
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
+  } else {
+    s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
+  }
+  return s;
+}
+}  // namespace
+
+std::string field_probe(const FieldArgs& f, double x, double y) {
+  require_range("field probe", "--x", x, -1.0, 1.0);
+  require_range("field probe", "--y", y, -1.0, 1.0);
+  check_common(f, "field probe");
+  const Setup s = make_setup(f);
+  const auto smp = s.field->at({x, y});
+  const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+  const Vec2 F = magnet::dipole_force(m, smp);
+  json j{{"preset", f.preset},         {"source", s.field->describe()}, {"x_m", x},
+         {"y_m", y},                   {"Bx_T", smp.B.x},                {"By_T", smp.B.y},
+         {"B_T", norm(smp.B)},         {"dBx_dx_T_per_m", smp.dB.xx},    {"dBx_dy_T_per_m", smp.dB.xy},
+         {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius},
+         {"mx_Am2", m.x},              {"my_Am2", m.y},                  {"moment_Am2", norm(m)},
+         {"Fx_N", F.x},                {"Fy_N", F.y},                    {"force_N", norm(F)}};
+  return j.dump();
+}
+
+std::string field_export(const FieldArgs& f, double x0, double x1, int nx, double y0, double y1, int ny, const std::string& out) {
+  // the checks of `nipdem field export`, plus those of the probe's magnet options
+  require_range("field export", "--nx", nx, 5, 1e5);
+  require_range("field export", "--ny", ny, 5, 1e5);
+  check_common(f, "field export");
+  if (!f.map.empty()) throw_input("field export", "--map", f.map, "export samples a preset magnet, not a map");
+  require_range("field export", "--x0", x0, -1.0, 1.0);
+  require_range("field export", "--x1", x1, -1.0, 1.0);
+  require_range("field export", "--y0", y0, -1.0, 1.0);
+  require_range("field export", "--y1", y1, -1.0, 1.0);
+  if (static_cast<double>(nx) * ny > 1e7)
+    throw_input("field export", "--nx, --ny", fmt::format("{} x {}", nx, ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
+  if (!(x1 > x0)) throw_input("field export", "--x1", fmt::format("{:g}", x1), "must exceed x0", "> x0");
+  if (!(y1 > y0)) throw_input("field export", "--y1", fmt::format("{:g}", y1), "must exceed y0", "> y0");
+  const Setup s = make_setup(f);
+  io::write_file_atomic(out, io::field_to_csv(*s.field, x0, x1, nx, y0, y1, ny, s.field->describe() + ", magnet frame (see docs/magnetic.md)"));
+  return json{{"out", out}, {"source", s.field->describe()}, {"nx", nx}, {"ny", ny}}.dump();
+}
+
+double rc_default_Rm() { return probe::ProbeCircuitParams{}.Rm_ohm; }
+
+std::string rc_response(double R, double Rd, double C, double Rm, double voltage, const std::string& freq) {
+  probe::ProbeCircuitParams p;
+  p.R_ohm = R;
+  p.Rd_ohm = Rd;
+  p.C_F = C;
+  p.Rm_ohm = Rm;
+  p.validate();
+  require_range("rc response", "--R", p.R_ohm, 1e-3, 1e30);
+  require_range("rc response", "--Rd", p.Rd_ohm, 1e-3, 1e40);
+  require_range("rc response", "--C", p.C_F, 1e-24, 1.0);
+  require_range("rc response", "--voltage", voltage, -1e6, 1e6);
+  const auto fs = probe::parse_frequency_range(freq);
+  json rows = json::array();
+  for (double f : fs) {
+    const auto r = probe::response(p, voltage, f);
+    if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))
+      throw_input("rc response", "--R, --Rd, --C, --voltage", fmt::format("at {:g} Hz", f), "the response is not computable for these inputs");
+    rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
+  }
+  json j;
+  j["rows"] = rows;
+  j["R_ohm"] = p.R_ohm;
+  j["Rd_ohm"] = p.Rd_ohm;
+  j["C_F"] = p.C_F;
+  j["Rm_ohm"] = p.Rm_ohm;
+  j["voltage_V"] = voltage;
+  return j.dump();
+}
+
+std::string ldc_verify() {
+  namespace lv = ldc::verify;
+  auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  const auto t31 = lv::table_3_1();
+  const auto t32 = lv::table_3_2();
+  const auto t33 = lv::table_3_3();
+  const auto t34 = lv::table_3_4();
+  const auto f36 = lv::fig_3_6();
+  json j;
+  j["table_3_1"] = json::array();
+  for (const auto& r : t31) j["table_3_1"].push_back({{"i", r.i}, {"kappa_eps0", r.kappa_eps0}, {"kappa_eps005", r.kappa_eps005}});
+  j["table_3_2"] = json::array();
+  for (const auto& r : t32) j["table_3_2"].push_back({{"H", r.H}, {"i", r.i}, {"delta", r.delta}, {"rho", opt(r.rho)}});
+  j["table_3_3"] = json::array();
+  for (const auto& r : t33) j["table_3_3"].push_back({{"H", r.H}, {"i", r.i}, {"kappa", r.kappa}, {"sigma", opt(r.sigma)}});
+  j["table_3_4"] = json::array();
+  for (const auto& r : t34) j["table_3_4"].push_back({{"i", r.i}, {"nu", r.nu}, {"tau", opt(r.tau)}});
+  j["fig_3_6"] = {{"charge_error_1", f36.charge_error_1}, {"charge_error_2", f36.charge_error_2}};
+  return j.dump();
+}
+
+namespace {
+// Reads the option object of run_experiment: every key must be consumed.
+class Options {
+ public:
+  Options(const std::string& text, std::string where) : where_(std::move(where)) {
+    try {
+      j_ = json::parse(text);
+    } catch (const json::exception& e) {
+      throw InputError(where_ + ": options are not a JSON object (" + e.what() + ")");
+    }
+    if (!j_.is_object()) throw InputError(where_ + ": options are not a JSON object");
+  }
+  template <class T>
+  void get(const char* key, T& v) {
+    if (!j_.contains(key) || j_[key].is_null()) return;
+    try {
+      if constexpr (std::is_same_v<T, double>) {
+        v = number(j_[key]);
+      } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+        if (!j_[key].is_array()) throw json::type_error::create(302, "not an array", nullptr);
+        v.clear();
+        for (const auto& x : j_[key]) v.push_back(number(x));
+      } else {
+        v = j_[key].get<T>();
+      }
+    } catch (const json::exception&) {
+      throw_input(where_, key, j_[key].dump(), "wrong type");
+    }
+    used_.insert(key);
+  }
+  // JSON has no NaN or infinity: the package sends them as the strings "nan", "inf", "-inf",
+  // so that the experiment's own range check reports them as the CLI does.
+  static double number(const json& x) {
+    if (x.is_string()) {
+      const auto& t = x.get_ref<const std::string&>();
+      if (t == "nan") return std::numeric_limits<double>::quiet_NaN();
+      if (t == "inf") return std::numeric_limits<double>::infinity();
+      if (t == "-inf") return -std::numeric_limits<double>::infinity();
+    }
+    return x.get<double>();
+  }
+  void finish() const {
+    for (const auto& [k, v] : j_.items())
+      if (!used_.count(k) && !v.is_null()) throw_input(where_, k, v.dump(), "unknown option of this experiment");
+  }
+
+ private:
+  std::string where_;
+  json j_;
+  std::set<std::string> used_;
+};
+}  // namespace
+
+std::string run_experiment(const std::string& name, const std::string& options) {
+  using namespace experiments;
+  Options op(options, "experiment " + name);
+  ExperimentOptions o;
+  std::string out;
+  op.get("preset", o.preset);
+  op.get("config", o.config);
+  op.get("sets", o.sets);
+  op.get("seed", o.seed);
+  op.get("jobs", o.jobs);
+  op.get("progress", o.progress);
+  op.get("out", out);
+  if (o.jobs < 1 || o.jobs > 256) throw_input("experiment " + name, "--jobs", std::to_string(o.jobs), "out of range", "[1, 256]");
+  o.out = out.empty() ? "runs/" + name : out;  // the CLI's default
+  json j;
+  if (name == "front-position") {
+    FrontPositionOptions f;
+    op.get("gaps_m", f.gaps_m);
+    op.get("sleeve_speeds_m_per_min", f.sleeve_speeds_m_per_min);
+    op.get("max_time_s", f.max_time_s);
+    op.get("min_time_s", f.min_time_s);
+    op.finish();
+    j = front_position(o, f);
+  } else if (name == "reduction") {
+    ReductionOptions r;
+    op.get("cohesion_ratios", r.cohesion_ratios);
+    op.get("time_s", r.time_s);
+    op.get("pile_width_m", r.pile_width_m);
+    op.get("pile_height_m", r.pile_height_m);
+    op.get("pits", r.pits);
+    op.finish();
+    j = reduction(o, r);
+  } else if (name == "vo-level") {
+    VoOptions v;
+    op.get("step_V", v.step_V);
+    op.get("coarse_step_V", v.coarse_step_V);
+    op.get("v0_V", v.v0_V);
+    op.get("v_max_V", v.v_max_V);
+    op.get("seeds", v.seeds);
+    op.get("line_length_m", v.print.line_length_m);
+    op.get("line_start_m", v.print.line_start_m);
+    op.get("extra_time_s", v.print.extra_time_s);
+    op.finish();
+    if (!(v.print.extra_time_s >= 0.0 && v.print.extra_time_s <= 1.0))
+      throw_input("experiment vo-level", "--extra-time", fmt::format("{:g}", v.print.extra_time_s), "out of range", "[0, 1]");
+    j = vo_level(o, v);
+  } else if (name == "edge-sharpness") {
+    EdgeOptions e;
+    op.get("realizations", e.realizations);
+    op.get("line_length_m", e.print.line_length_m);
+    op.get("line_start_m", e.print.line_start_m);
+    op.get("extra_time_s", e.print.extra_time_s);
+    op.get("margin_m", e.margin_m);
+    op.get("bootstrap", e.bootstrap);
+    op.finish();
+    if (!(e.print.extra_time_s >= 0.0 && e.print.extra_time_s <= 1.0))
+      throw_input("experiment edge-sharpness", "--extra-time", fmt::format("{:g}", e.print.extra_time_s), "out of range", "[0, 1]");
+    j = edge_sharpness(o, e);
+  } else {
+    throw_input("experiment", "name", name, "unknown experiment", "front-position, reduction, vo-level, edge-sharpness");
+  }
+  // apps/cli/cmd_experiment.cpp finish(): the JSON next to the data, then the same failures
+  io::write_file_atomic(o.out / (name + ".json"), j.dump(2));
+  if (j.contains("bracketed") && !j["bracketed"].get<bool>())
+    throw std::runtime_error("the target was not bracketed (" + j.value("hint", std::string()) + "); see " + (o.out / (name + ".json")).string());
+  if (j.value("n_failed", 0) > 0)
+    throw std::runtime_error(std::to_string(j["n_failed"].get<int>()) + " point(s) failed; see \"failed\" in " + (o.out / (name + ".json")).string());
+  return j.dump();
+}
+
+}  // namespace nipdem::python
