@@ -18,8 +18,8 @@
 
 #include "functions.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/version.hpp"
 #include "simulation.hpp"

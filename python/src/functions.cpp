@@ -12,8 +12,12 @@
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/nip_experiments.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
+#include "nipdem/experiments/edge_sharpness.hpp"
+#include "nipdem/experiments/front_position.hpp"
+#include "nipdem/experiments/reduction.hpp"
+#include "nipdem/experiments/vo_level.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/models/dipole.hpp"
@@ -131,26 +135,17 @@ void check_common(const FieldArgs& c, const std::string& where) {
   if (c.br) require_range(where, "--br", *c.br, -2.5, 2.5);
 }
 Setup make_setup(const FieldArgs& c) {
+  // as apps/cli/cmd_field.cpp: the preset layer knows the magnet and the toner
   Setup s;
-  s.toner = magnet::preset_toner(c.preset);
-  s.radius = c.radius.value_or(0.0) == 0.0 ? magnet::preset_d50_radius(c.preset) : *c.radius;
+  const experiments::PresetToner t = experiments::preset_toner(c.preset);
+  s.toner = t.magnetisation;
+  s.radius = c.radius.value_or(t.d50_radius_m);
   require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  const bool custom = c.tip_depth || c.br;
   if (!c.map.empty()) {
-    if (custom) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
+    if (c.tip_depth || c.br) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
     s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
-  } else if (custom && c.preset == "black") {
-    magnet::KnifeParams k;
-    if (c.tip_depth) k.tip_depth_m = *c.tip_depth;
-    if (c.br) k.blade_Br_T = *c.br;
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_knife(k));
-  } else if (custom && c.preset == "color") {
-    magnet::ColorPoleParams k;
-    if (c.tip_depth) k.tip_depth_m = *c.tip_depth;
-    if (c.br) k.Br_T = *c.br;
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::make_color_pole(k));
   } else {
-    s.field = std::make_unique<magnet::BlockAssembly>(magnet::preset_field(c.preset));
+    s.field = std::make_unique<magnet::BlockAssembly>(experiments::preset_magnet(c.preset, {.tip_depth_m = c.tip_depth, .br_T = c.br}));
   }
   return s;
 }

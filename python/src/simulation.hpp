@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "nipdem/experiments/nip.hpp"
+#include "nipdem/nip/nip.hpp"
 
 namespace nipdem::python {
 
