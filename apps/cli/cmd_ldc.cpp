@@ -2,8 +2,6 @@
 // `nipdem ldc solve SETUP.{json,toml} [--json]`: solves one disc configuration (see docs/ldc.md).
 #include <cstdint>
 #include <cstdio>
-#include <sstream>
-#include <toml++/toml.h>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -11,6 +9,7 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/io/atomic_file.hpp"
 #include "nipdem/solvers/ldc/ldc_solver.hpp"
+#include "nipdem/solvers/ldc/setup_file.hpp"
 #include "nipdem/solvers/ldc/verify.hpp"
 #include "registry.hpp"
 
@@ -62,84 +61,13 @@ void run_verify(bool as_json) {
               f36.g2);
 }
 
-// Reads a setup file (JSON; keys in docs/ldc.md). Unknown or wrong-typed keys are InputErrors.
-nipdem::ldc::Params read_params(const json& j, std::vector<nipdem::ldc::Disc>& discs, const std::string& where) {
-  using namespace nipdem::ldc;
-  Params p;
-  auto num = [&](const json& o, const char* key, double& v) {
-    if (!o.contains(key)) return;
-    if (!o[key].is_number()) nipdem::throw_input(where, key, o[key].dump(), "must be a number");
-    v = o[key].get<double>();
-  };
-  auto integer = [&](const json& o, const char* key, int& v) {
-    if (!o.contains(key)) return;
-    if (!o[key].is_number_integer()) nipdem::throw_input(where, key, o[key].dump(), "must be an integer");
-    const auto w = o[key].get<std::int64_t>();
-    if (o[key].is_number_unsigned() && o[key].get<std::uint64_t>() > static_cast<std::uint64_t>(INT32_MAX))
-      nipdem::throw_input(where, key, o[key].dump(), "integer too large", "[-2^31, 2^31)");
-    if (w < INT32_MIN || w > INT32_MAX) nipdem::throw_input(where, key, o[key].dump(), "integer too large", "[-2^31, 2^31)");
-    v = static_cast<int>(w);
-  };
-  if (!j.is_object()) nipdem::throw_input(where, "", "", "setup must be a JSON object");
-  if (j.contains("box")) {
-    const json& b = j["box"];
-    num(b, "x_min_m", p.x_min_m);
-    num(b, "x_max_m", p.x_max_m);
-    num(b, "y_min_m", p.y_min_m);
-    num(b, "y_max_m", p.y_max_m);
-    integer(b, "cells_x", p.cells_x);
-    integer(b, "cells_y", p.cells_y);
-  }
-  if (j.contains("boundary")) {
-    const json& b = j["boundary"];
-    for (auto [name, side] : {std::pair{"bottom", &p.bottom}, {"top", &p.top}, {"left", &p.left}, {"right", &p.right}}) {
-      if (!b.contains(name)) continue;
-      const json& s = b[name];
-      const std::string kind = s.value("kind", "dirichlet");
-      if (kind == "dirichlet") side->kind = SideKind::dirichlet;
-      else if (kind == "neumann") side->kind = SideKind::neumann;
-      else nipdem::throw_input(where, std::string("boundary.") + name + ".kind", kind, "unknown kind", "dirichlet, neumann");
-      num(s, "value_V", side->value_V);
-    }
-  }
-  num(j, "permittivity_F_per_m", p.permittivity_F_per_m);
-  num(j, "local_radius_factor", p.local_radius_factor);
-  num(j, "safety_m", p.safety_m);
-  num(j, "tolerance", p.tolerance);
-  integer(j, "max_iterations", p.max_iterations);
-  integer(j, "fd_refinement", p.fd_refinement);
-  if (!j.contains("discs") || !j["discs"].is_array()) nipdem::throw_input(where, "discs", "", "missing array of discs");
-  for (const json& d : j["discs"]) {
-    Disc disc;
-    num(d, "x_m", disc.center_m.x);
-    num(d, "y_m", disc.center_m.y);
-    num(d, "radius_m", disc.radius_m);
-    num(d, "charge_C_per_m", disc.charge_C_per_m);
-    discs.push_back(disc);
-  }
-  return p;
-}
-
 void run_solve(const std::string& path, bool as_json) {
   using namespace nipdem::ldc;
-  json j;
   const std::string text = nipdem::io::read_file(path);
   const bool is_toml = path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
-  try {
-    if (is_toml) {  // same keys as the JSON form; [[discs]] array of tables
-      std::ostringstream os;
-      os << toml::json_formatter{toml::parse(text, path)};
-      j = json::parse(os.str());
-    } else {
-      j = json::parse(text);
-    }
-  } catch (const toml::parse_error& e) {
-    nipdem::throw_input(path, "", "", std::string("invalid TOML: ") + std::string(e.description()));
-  } catch (const json::exception& e) {
-    nipdem::throw_input(path, "", "", std::string("invalid JSON: ") + e.what());
-  }
-  std::vector<Disc> discs;
-  const Params p = read_params(j, discs, path);
+  const Setup setup = parse_setup(text, path, is_toml);
+  const Params& p = setup.params;
+  const std::vector<Disc>& discs = setup.discs;
   // The solver names its component ("ldc"); a setup error must name the file as well.
   auto named = [&](const auto& f) {
     try {

@@ -109,6 +109,8 @@ TEST(HostileCli, BadConfigValuesAreRefusedNamingTheKey) {
       {run + " --set run.output_interval_s=inf", {"run.output_interval_s"}},
       {run + " --set run.seed=-1", {"run.seed"}},
       {run + " --set run.seed=1.5", {"run.seed"}},
+      {run + " --set run.seed=-2e291", {"run.seed"}},  // a float for an integer key: UB in its conversion (fuzz_config)
+      {run + " --set run.threads=1e300", {"run.threads"}},
       {run + " --set run.threads=0", {"run.threads"}},
       {run + " --set run.threads=100000", {"run.threads"}},
       {run + " --set run.dt_fraction_of_contact_time=nan", {"run.dt_fraction_of_contact_time"}},

@@ -135,8 +135,12 @@ def test_charges_follow_their_bodies_across_inflow_and_outflow(small_config):
         common = [i for i, b in enumerate(ids.tolist()) if b in before]
         prev = np.array([before[b] for b in ids[common].tolist()])
         scale = max(np.abs(prev).max(), 1e-9)
-        # one step of the RC update changes a voltage by ~dt/tau ~ 1e-3 of itself
-        np.testing.assert_allclose(u[common], prev, atol=1e-2 * scale)
+        # one step of the RC update changes a voltage by ~dt/tau ~ 1e-3 of itself, except for the
+        # few bodies that touch the drum or a charged neighbour in that very step (they charge at
+        # once); a wrong id -> voltage mapping would scramble most of them, so at most 5 % may
+        # differ by more than 1 % of the largest voltage
+        off = np.abs(u[common] - prev) > 1e-2 * scale
+        assert off.mean() <= 0.05, f"{off.sum()} of {len(common)} voltages moved in one step"
         assert np.all(u[[i for i, b in enumerate(ids.tolist()) if b not in before]] == 0)  # inserted: uncharged
         stored = sim._sim._voltages_as_stored()
         if np.abs(prev).max() > 0 and (len(stored) != len(u) or not np.allclose(stored, u, atol=1e-2 * scale)):

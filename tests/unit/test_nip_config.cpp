@@ -294,3 +294,22 @@ TEST(NipConfigTyped, ValidateChecksAnEditedConfiguration) {
   EXPECT_NO_THROW(validate(d));
   EXPECT_EQ(d.electric.pattern.segments().size(), 1u);
 }
+
+// fuzz_config found `run.seed = -2e291`: toml++'s value<int64_t>() converts a float node, which
+// is undefined for |x| >= 2^63. Every integer key must be refused by type before any conversion.
+TEST(NipConfigIntegers, FloatsForIntegerKeysAreRefusedByTypeWhateverTheirSize) {
+  for (const std::string v : {"-2e291", "1e300", "9.3e18", "-inf", "nan", "1.0"}) {
+    for (const std::string key : {"seed", "threads"}) {
+      const std::string text = "[run]\n" + key + " = " + v + "\n";
+      try {
+        parse_nip_config(text, "f.toml");
+        ADD_FAILURE() << "accepted " << text;
+      } catch (const InputError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("f.toml"), std::string::npos) << m;
+        EXPECT_NE(m.find("run." + key), std::string::npos) << m;
+        EXPECT_NE(m.find("must be an integer"), std::string::npos) << m;
+      }
+    }
+  }
+}

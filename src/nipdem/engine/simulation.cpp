@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <istream>
 #include <limits>
 #include <ostream>
 #include <stdexcept>
 
+#include <fmt/format.h>
 #include <omp.h>
 
 #include "nipdem/core/constants.hpp"
@@ -212,12 +214,22 @@ void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
 // in the drift loop).
 void Simulation::ensure_neighbor_list(int moved) {
   nl_params_.threads = params_.threads;
-  if (structure_changed_) {
-    nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
-  } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
-    nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
-  } else {
-    return;
+  try {
+    if (structure_changed_) {
+      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
+    } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
+      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
+    } else {
+      return;
+    }
+  } catch (const geometry::BadPositionError& e) {
+    // A runtime failure (exit 1), not an input error: a checkpoint's positions are checked
+    // when it is read, so the state blew up during the run. Say when and which body.
+    const int b = e.disc() < d_.body.size() ? d_.body[e.disc()] : -1;
+    throw std::runtime_error(fmt::format(
+        "engine: at t = {} s (step {}), body id {}: {} (the state has blown up: time step too large for the forces, "
+        "or a force that is not finite?)",
+        time_, step_, b >= 0 && static_cast<std::size_t>(b) < b_.id.size() ? b_.id[b] : -1, e.what()));
   }
   structure_changed_ = false;
   for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
@@ -390,9 +402,17 @@ void Simulation::contact_forces() {
   update_thread_split();
   pdisc_.resize(n);
   pvel_.resize(n);
+  // Every buffer the region writes is sized here: nothing allocates inside it (an exception must
+  // not cross an OpenMP region), except the wall queries' scratch, whose failures are carried out.
   if (static_cast<int>(tforce_.size()) != nt) tforce_.assign(nt, {});
   if (static_cast<int>(tadh_.size()) != nt) tadh_.assign(nt, {});
+  for (auto& buf : tforce_)
+    if (static_cast<int>(buf.size()) < n) buf.resize(n);
+  if (adh)
+    for (auto& ab : tadh_)
+      if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
   thread_nc_.assign(nt, 0);
+  if (has_walls) thread_fail_.assign(nt, nullptr);
 #pragma omp parallel num_threads(nt)
   {
     const int t = omp_get_thread_num();
@@ -404,26 +424,29 @@ void Simulation::contact_forces() {
       pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
     }
     // (implicit barrier: every thread reads all packed discs)
-    auto& buf = tforce_[t];
-    if (static_cast<int>(buf.size()) < n) buf.resize(n);
-    const int lo = split_[t], hi = reach_hi_[t];
-    std::fill(buf.begin() + lo, buf.begin() + hi, PackedForce{0.0, 0.0, 0.0, 0.0});
-    double* fa = nullptr;
-    if (adh) {
-      auto& ab = tadh_[t];
-      if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
-      std::fill(ab.begin() + 2 * lo, ab.begin() + 2 * hi, 0.0);
-      fa = ab.data();
+    // Row chunk u (of nt) goes to thread u mod T: the same sums even if the runtime gave fewer
+    // threads than asked for (OMP_DYNAMIC, OMP_THREAD_LIMIT, a nested region); one chunk each else.
+    const int team = omp_get_num_threads();
+    for (int u = t; u < nt; u += team) {
+      auto& buf = tforce_[u];
+      const int lo = split_[u], hi = reach_hi_[u];
+      std::fill(buf.begin() + lo, buf.begin() + hi, PackedForce{0.0, 0.0, 0.0, 0.0});
+      double* fa = nullptr;
+      if (adh) {
+        auto& ab = tadh_[u];
+        std::fill(ab.begin() + 2 * lo, ab.begin() + 2 * hi, 0.0);
+        fa = ab.data();
+      }
+      std::int64_t nc = 0;
+      if (adh) {
+        if (periodic) pair_rows<true, true>(lo, split_[u + 1], buf.data(), fa, nc);
+        else pair_rows<true, false>(lo, split_[u + 1], buf.data(), fa, nc);
+      } else {
+        if (periodic) pair_rows<false, true>(lo, split_[u + 1], buf.data(), fa, nc);
+        else pair_rows<false, false>(lo, split_[u + 1], buf.data(), fa, nc);
+      }
+      thread_nc_[u] = nc;
     }
-    std::int64_t nc = 0;
-    if (adh) {
-      if (periodic) pair_rows<true, true>(lo, split_[t + 1], buf.data(), fa, nc);
-      else pair_rows<true, false>(lo, split_[t + 1], buf.data(), fa, nc);
-    } else {
-      if (periodic) pair_rows<false, true>(lo, split_[t + 1], buf.data(), fa, nc);
-      else pair_rows<false, false>(lo, split_[t + 1], buf.data(), fa, nc);
-    }
-    thread_nc_[t] = nc;
     std::int64_t wall_nc = 0;
 #pragma omp barrier
     // Reduce in fixed thread order (bitwise reproducible for a given thread count), each
@@ -438,13 +461,22 @@ void Simulation::contact_forces() {
         if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
-      if (has_walls) wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
+      if (has_walls) {
+        try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
+          wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
+        } catch (...) {
+          if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
+        }
+      }
     }
     thread_nc_[t] += wall_nc;
     // (implicit barrier: a body's discs may lie in another thread's slice)
 #pragma omp for schedule(static)
     for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
   }
+  if (has_walls)
+    for (const auto& e : thread_fail_)
+      if (e) std::rethrow_exception(e);
   std::int64_t total = 0;
   for (auto c : thread_nc_) total += c;
   n_contacts_ = total;

@@ -14,6 +14,7 @@
 //    mapping so tangential history survives renumbering.
 #pragma once
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <iosfwd>
 #include <memory>
@@ -177,6 +178,7 @@ class Simulation {
   std::vector<double> thread_disp_;  // per thread: two largest squared disc displacements
   int split_builds_ = -1, split_threads_ = 0;
   std::vector<std::vector<geometry::WallHit>> thread_hits_;  // per-thread wall query scratch
+  std::vector<std::exception_ptr> thread_fail_;              // per thread: first failure of its wall queries
   std::vector<double> wall_reach_;                          // adhesion reach of each wall [m]
   std::vector<std::uint32_t> wall_mask_;                    // per disc: walls it may touch until the next list build
   std::vector<WallShape> wall_shape_;                       // wall shapes the masks were built for

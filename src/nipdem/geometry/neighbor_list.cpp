@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
 
+#include <fmt/format.h>
 #include <omp.h>
 
 namespace nipdem::geometry {
@@ -21,26 +23,51 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   const std::size_t n = x.size();
   params_ = p;
   skin_ = p.skin;
-  ++builds_;
   new_start_.assign(n + 1, 0);
   new_nbr_.clear();
   new_eta_.clear();
   new_slide_.clear();
   if (n == 0) {
+    ++builds_;
     row_start_ = new_start_;
     nbr_.clear(); eta_.clear(); slide_.clear();
     x0_.clear(); y0_.clear();
     return;
   }
   double rmax = 0.0, xmin = x[0], xmax = x[0], ymin = y[0], ymax = y[0];
+  bool finite = true;
   for (std::size_t i = 0; i < n; ++i) {
     rmax = std::max(rmax, r[i]);
     xmin = std::min(xmin, x[i]); xmax = std::max(xmax, x[i]);
     ymin = std::min(ymin, y[i]); ymax = std::max(ymax, y[i]);
+    finite = finite & std::isfinite(x[i]) & std::isfinite(y[i]);
   }
   const double reach = p.skin + p.extra_range;
   double cell = 2.0 * rmax + reach;
   const double L = p.x_hi - p.x_lo;
+  // Refuse what cannot be binned before anything depends on it (nothing has changed yet except
+  // the scratch start array and the parameters, which the next build sets again).
+  if (!finite || !(std::max(xmax - xmin, ymax - ymin) <= kMaxCellsPerAxis * cell)) {
+    std::size_t bad = 0;
+    if (!finite) {
+      while (std::isfinite(x[bad]) && std::isfinite(y[bad])) ++bad;
+    } else {  // the disc farthest from the median position is the one flung away
+      std::vector<double> xs(x.begin(), x.end()), ys(y.begin(), y.end());
+      std::nth_element(xs.begin(), xs.begin() + n / 2, xs.end());
+      std::nth_element(ys.begin(), ys.begin() + n / 2, ys.end());
+      const double cx = xs[n / 2], cy = ys[n / 2];
+      double far = -1.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double d = std::max(std::abs(x[i] - cx), std::abs(y[i] - cy));
+        if (d > far) { far = d; bad = i; }
+      }
+    }
+    throw BadPositionError(bad, x[bad], y[bad],
+                           fmt::format("neighbour list: disc {} at ({}, {}) m: {}", bad, x[bad], y[bad],
+                                       finite ? "so far from the other discs that it cannot be binned (more than 2^30 cells)"
+                                              : "position is not finite"));
+  }
+  ++builds_;
   int nx, ny;
   if (p.periodic_x) {
     xmin = p.x_lo;
@@ -77,8 +104,12 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   const bool has_old = !old_of_new.empty();
   const bool has_prev = !row_start_.empty();
   for (int t = 0; t < nt; ++t) { rows_[t].nbr.clear(); rows_[t].eta.clear(); rows_[t].slide.clear(); }
+  // The rows grow inside the region: a bad_alloc there must not cross it (std::terminate).
+  // Each thread keeps its own and the lowest thread's is rethrown after the region.
+  std::vector<std::exception_ptr> failure(static_cast<std::size_t>(nt));
 #pragma omp parallel num_threads(nt) if (nt > 1)
   {
+  try {
     const int T = omp_get_num_threads(), t = omp_get_thread_num();
     const std::size_t i_lo = n * t / T, i_hi = n * (t + 1) / T;
     Rows& out = rows_[t];
@@ -131,7 +162,12 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
       }
       new_start_[i + 1] = static_cast<int>(row.size());  // count now, offset below
     }
+  } catch (...) {
+    failure[static_cast<std::size_t>(omp_get_thread_num())] = std::current_exception();
   }
+  }
+  for (const auto& e : failure)
+    if (e) std::rethrow_exception(e);
   for (std::size_t i = 0; i < n; ++i) new_start_[i + 1] += new_start_[i];
   new_nbr_.resize(new_start_[n]);
   new_eta_.resize(new_start_[n]);

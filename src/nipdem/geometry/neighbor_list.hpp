@@ -4,11 +4,31 @@
 // History survives rebuilds and renumbering (bodies removed/added): see rebuild().
 #pragma once
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace nipdem::geometry {
+
+// A disc position the cell list cannot bin: not finite, or so far from the others that the cell
+// indices would overflow (more than kMaxCellsPerAxis cells of 2 r_max + skin between them). The
+// state has blown up; rebuild() refuses it instead of binning garbage (UB) or looping.
+class BadPositionError : public std::runtime_error {
+ public:
+  BadPositionError(std::size_t disc, double x, double y, const std::string& what)
+      : std::runtime_error(what), disc_(disc), x_(x), y_(y) {}
+  std::size_t disc() const { return disc_; }
+  double x() const { return x_; }
+  double y() const { return y_; }
+
+ private:
+  std::size_t disc_;
+  double x_, y_;
+};
 
 struct NeighborListParams {
   double skin = 1e-6;           // extra distance beyond the interaction range [m]
@@ -24,6 +44,8 @@ class NeighborList {
   // (discs of one rigid cluster never interact). old_of_new[i] is the index disc i had at the
   // previous build (-1 if new); history of pairs present in both lists is carried over.
   // Pass an empty span if no disc was renumbered since the last build.
+  // Throws BadPositionError (list unchanged) for a position that cannot be binned (see there).
+  // No exception leaves the parallel row search: one thrown there (bad_alloc) is rethrown after it.
   void rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,
                std::span<const int> body, std::span<const int> old_of_new, const NeighborListParams& p);
 
@@ -46,12 +68,18 @@ class NeighborList {
   }
   // True if the two largest squared displacements d1 >= d2 call for a rebuild.
   bool exceeds(double d1, double d2) const { return std::sqrt(d1) + std::sqrt(d2) > skin_; }
-  // Folds squared displacement d into the running top two (d1 >= d2).
+  // Folds squared displacement d into the running top two (d1 >= d2). A NaN (a disc whose
+  // position became NaN) counts as infinitely far, so that it forces a rebuild and rebuild()
+  // refuses it; compared as NaN it would be dropped by the next comparison.
   static void top2(double d, double& d1, double& d2) {
+    if (d != d) d = std::numeric_limits<double>::infinity();
     if (d > d2) {
       if (d > d1) { d2 = d1; d1 = d; } else { d2 = d; }
     }
   }
+  // Cells along one axis beyond which a disc counts as flung away (BadPositionError): 2^30 cells
+  // of ~10 um are ~10 km, far outside any nip; below it the cell count is capped (O(N) memory).
+  static constexpr double kMaxCellsPerAxis = 1073741824.0;
 
   std::size_t size() const { return row_start_.empty() ? 0 : row_start_.size() - 1; }
   std::size_t pair_count() const { return nbr_.size(); }

@@ -208,6 +208,8 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
   for (std::size_t i = 0; i < n; ++i) pk_[i] = {x[i], y[i], m[i].x, m[i].y};
   const int nt = p_.threads;
   buf_.resize(static_cast<std::size_t>(nt));
+  for (auto& bv : buf_)  // sized here: nothing may allocate (and throw) inside the region
+    if (bv.size() < 2 * n) bv.resize(2 * n);
   const double rc2 = p_.cutoff_m * p_.cutoff_m;
   const double k3 = 3.0 * k_mu0_4pi;
   const Packed* pk = pk_.data();
@@ -216,39 +218,42 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
 #pragma omp parallel num_threads(nt)
   {
     const int t = omp_get_thread_num();
-    auto& bv = buf_[static_cast<std::size_t>(t)];
-    bv.assign(2 * n, 0.0);
-    double* f = bv.data();
-    // rows split by index, so the summation order does not depend on the list content
-    const std::size_t i0 = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
-    const std::size_t i1 = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(nt);
-    for (std::size_t i = i0; i < i1; ++i) {
-      const Packed pi = pk[i];
-      double fxi = 0.0, fyi = 0.0;
-      for (int e = rs[i]; e < rs[i + 1]; ++e) {
-        const int j = nb[e];
-        const Packed pj = pk[j];
-        const double dx = pi.x - pj.x, dy = pi.y - pj.y;
-        const double r2 = dx * dx + dy * dy;
-        if (!(r2 < rc2)) continue;
-        // eq. 2.4.39 with e = r/|r|: F_i = 3k/r^5 [a m_j + b m_i + (c - 5 a b / r^2) r],
-        // a = m_i.r, b = m_j.r, c = m_i.m_j (the same law as dipole_force, one sqrt, one division)
-        const double ir2 = 1.0 / r2;
-        const double ir = std::sqrt(ir2);
-        const double a = pi.mx * dx + pi.my * dy;
-        const double b = pj.mx * dx + pj.my * dy;
-        const double c = pi.mx * pj.mx + pi.my * pj.my;
-        const double pre = k3 * ir2 * ir2 * ir;
-        const double s = c - 5.0 * a * b * ir2;
-        const double gx = pre * (a * pj.mx + b * pi.mx + s * dx);
-        const double gy = pre * (a * pj.my + b * pi.my + s * dy);
-        fxi += gx;
-        fyi += gy;
-        f[2 * j] -= gx;
-        f[2 * j + 1] -= gy;
+    // Row chunk u (of nt) goes to thread u mod T: the same sums if the runtime gave fewer threads.
+    const int team = omp_get_num_threads();
+    for (int u = t; u < nt; u += team) {
+      double* f = buf_[static_cast<std::size_t>(u)].data();
+      std::fill(f, f + 2 * n, 0.0);
+      // rows split by index, so the summation order does not depend on the list content
+      const std::size_t i0 = n * static_cast<std::size_t>(u) / static_cast<std::size_t>(nt);
+      const std::size_t i1 = n * static_cast<std::size_t>(u + 1) / static_cast<std::size_t>(nt);
+      for (std::size_t i = i0; i < i1; ++i) {
+        const Packed pi = pk[i];
+        double fxi = 0.0, fyi = 0.0;
+        for (int e = rs[i]; e < rs[i + 1]; ++e) {
+          const int j = nb[e];
+          const Packed pj = pk[j];
+          const double dx = pi.x - pj.x, dy = pi.y - pj.y;
+          const double r2 = dx * dx + dy * dy;
+          if (!(r2 < rc2)) continue;
+          // eq. 2.4.39 with e = r/|r|: F_i = 3k/r^5 [a m_j + b m_i + (c - 5 a b / r^2) r],
+          // a = m_i.r, b = m_j.r, c = m_i.m_j (the same law as dipole_force, one sqrt, one division)
+          const double ir2 = 1.0 / r2;
+          const double ir = std::sqrt(ir2);
+          const double a = pi.mx * dx + pi.my * dy;
+          const double b = pj.mx * dx + pj.my * dy;
+          const double c = pi.mx * pj.mx + pi.my * pj.my;
+          const double pre = k3 * ir2 * ir2 * ir;
+          const double s = c - 5.0 * a * b * ir2;
+          const double gx = pre * (a * pj.mx + b * pi.mx + s * dx);
+          const double gy = pre * (a * pj.my + b * pi.my + s * dy);
+          fxi += gx;
+          fyi += gy;
+          f[2 * j] -= gx;
+          f[2 * j + 1] -= gy;
+        }
+        f[2 * i] += fxi;
+        f[2 * i + 1] += fyi;
       }
-      f[2 * i] += fxi;
-      f[2 * i + 1] += fyi;
     }
 #pragma omp barrier
 #pragma omp for schedule(static)
