@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -228,11 +229,19 @@ TEST(TimeStepStudy, EnergyDriftAgainstDtFraction) {
         sim.compute_forces();
         const double E0 = sim.energy().total();
         double maxdev = 0;
-        while (sim.time() < 2000 * tn) {
-          for (int i = 0; i < 5; ++i) sim.step();
-          maxdev = std::max(maxdev, std::fabs(sim.energy().total() - E0) / E0);
+        double end = 0;
+        try {
+          while (sim.time() < 2000 * tn) {
+            for (int i = 0; i < 5; ++i) sim.step();
+            maxdev = std::max(maxdev, std::fabs(sim.energy().total() - E0) / E0);
+          }
+          end = (sim.energy().total() - E0) / E0;
+        } catch (const std::exception& e) {
+          // the engine refuses a state that has blown up (a disc flung beyond binning): the
+          // energy grew without bound; only the non-symplectic scheme may do this
+          EXPECT_EQ(integ, Integrator::newmark_explicit) << e.what();
+          maxdev = end = std::numeric_limits<double>::infinity();
         }
-        const double end = (sim.energy().total() - E0) / E0;
         if (out) out << name(integ) << ',' << f << ',' << seed << ',' << maxdev << ',' << end << '\n';
         w = std::max(w, maxdev);
         if (f == kFractions[0]) gain_at_smallest = std::min(gain_at_smallest, end);
