@@ -17,28 +17,14 @@ namespace {
 using nlohmann::json;
 namespace lv = nipdem::ldc::verify;
 
-json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-
 void run_verify(bool as_json) {
-  const auto t31 = lv::table_3_1();
-  const auto t32 = lv::table_3_2();
-  const auto t33 = lv::table_3_3();
-  const auto t34 = lv::table_3_4();
-  const auto f36 = lv::fig_3_6();
+  const lv::Report rep = lv::run_all();
   if (as_json) {
-    json j;
-    j["table_3_1"] = json::array();
-    for (const auto& r : t31) j["table_3_1"].push_back({{"i", r.i}, {"kappa_eps0", r.kappa_eps0}, {"kappa_eps005", r.kappa_eps005}});
-    j["table_3_2"] = json::array();
-    for (const auto& r : t32) j["table_3_2"].push_back({{"H", r.H}, {"i", r.i}, {"delta", r.delta}, {"rho", opt(r.rho)}});
-    j["table_3_3"] = json::array();
-    for (const auto& r : t33) j["table_3_3"].push_back({{"H", r.H}, {"i", r.i}, {"kappa", r.kappa}, {"sigma", opt(r.sigma)}});
-    j["table_3_4"] = json::array();
-    for (const auto& r : t34) j["table_3_4"].push_back({{"i", r.i}, {"nu", r.nu}, {"tau", opt(r.tau)}});
-    j["fig_3_6"] = {{"charge_error_1", f36.charge_error_1}, {"charge_error_2", f36.charge_error_2}};
-    nipdem::cli::print_json(j.dump());
+    nipdem::cli::print_json(lv::to_json(rep).dump());
     return;
   }
+  const auto& t31 = rep.t31; const auto& t32 = rep.t32; const auto& t33 = rep.t33; const auto& t34 = rep.t34;
+  const auto& f36 = rep.f36;
   std::printf("Table 3.1  kappa_i, square hole, H = 1/20, h = H/2\n%4s %12s %12s\n", "i", "eps=0", "eps=0.05");
   for (const auto& r : t31) std::printf("%4d %12.3e %12.3e\n", r.i, r.kappa_eps0, r.kappa_eps005);
   std::printf("\nTable 3.2  delta_i on Gamma, analytic local solution\n%8s %4s %12s %12s\n", "H", "i", "delta", "rho");

@@ -27,17 +27,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     const NipConfig cfg = o->config.empty() ? parse_nip_config(preset_text(o->preset), "preset:" + o->preset, o->sets)
                                             : load_nip_config(o->config, o->sets);
     const auto ts = choose_time_step(cfg);
-    nlohmann::json j;
-    for (const auto& r : collision_report(cfg)) {
-      j[r.name] = {{"k_N_per_m", r.k}, {"gamma_Ns_per_m", r.gamma}, {"ks_N_per_m", r.ks}, {"restitution", r.restitution},
-                   {"contact_time_s", r.contact_time}, {"dt_max_s", r.dt_max_newmark}, {"dt_max_verlet_s", r.dt_max_verlet},
-                   {"gamma_thesis_convention_Ns_per_m", r.gamma_thesis}, {"reduced_mass_kg", r.m_red}};
-    }
-    j["stiffness_scale"] = cfg.stiffness_scale;
-    j["dt_s"] = ts.dt;
-    j["dt_bound_s"] = ts.bound;
-    j["dt_limited_by"] = ts.limiting;
-    if (o->json) { nipdem::cli::print_json(j.dump()); return; }
+    if (o->json) { nipdem::cli::print_json(collision_json(cfg).dump()); return; }
     std::printf("%-14s %10s %12s %10s %6s %12s %14s %14s\n", "type", "k [N/m]", "gamma [Ns/m]", "ks [N/m]", "e", "t_n [s]",
                 "dt_max NM [s]", "dt_max VV [s]");
     for (const auto& r : collision_report(cfg))

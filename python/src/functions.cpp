@@ -32,20 +32,7 @@ namespace nipdem::python {
 using nlohmann::json;
 
 std::string collision_params(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
-  using namespace experiments;
-  const NipConfig cfg = parse_nip_config(text, file, overrides);
-  const auto ts = choose_time_step(cfg);
-  json j;
-  for (const auto& r : collision_report(cfg)) {
-    j[r.name] = {{"k_N_per_m", r.k}, {"gamma_Ns_per_m", r.gamma}, {"ks_N_per_m", r.ks}, {"restitution", r.restitution},
-                 {"contact_time_s", r.contact_time}, {"dt_max_s", r.dt_max_newmark}, {"dt_max_verlet_s", r.dt_max_verlet},
-                 {"gamma_thesis_convention_Ns_per_m", r.gamma_thesis}, {"reduced_mass_kg", r.m_red}};
-  }
-  j["stiffness_scale"] = cfg.stiffness_scale;
-  j["dt_s"] = ts.dt;
-  j["dt_bound_s"] = ts.bound;
-  j["dt_limited_by"] = ts.limiting;
-  return j.dump();
+  return experiments::collision_json(experiments::parse_nip_config(text, file, overrides)).dump();
 }
 
 ElectricArgs::ElectricArgs()
@@ -218,26 +205,7 @@ std::string rc_response(double R, double Rd, double C, double Rm, double voltage
   return j.dump();
 }
 
-std::string ldc_verify() {
-  namespace lv = ldc::verify;
-  auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
-  const auto t31 = lv::table_3_1();
-  const auto t32 = lv::table_3_2();
-  const auto t33 = lv::table_3_3();
-  const auto t34 = lv::table_3_4();
-  const auto f36 = lv::fig_3_6();
-  json j;
-  j["table_3_1"] = json::array();
-  for (const auto& r : t31) j["table_3_1"].push_back({{"i", r.i}, {"kappa_eps0", r.kappa_eps0}, {"kappa_eps005", r.kappa_eps005}});
-  j["table_3_2"] = json::array();
-  for (const auto& r : t32) j["table_3_2"].push_back({{"H", r.H}, {"i", r.i}, {"delta", r.delta}, {"rho", opt(r.rho)}});
-  j["table_3_3"] = json::array();
-  for (const auto& r : t33) j["table_3_3"].push_back({{"H", r.H}, {"i", r.i}, {"kappa", r.kappa}, {"sigma", opt(r.sigma)}});
-  j["table_3_4"] = json::array();
-  for (const auto& r : t34) j["table_3_4"].push_back({{"i", r.i}, {"nu", r.nu}, {"tau", opt(r.tau)}});
-  j["fig_3_6"] = {{"charge_error_1", f36.charge_error_1}, {"charge_error_2", f36.charge_error_2}};
-  return j.dump();
-}
+std::string ldc_verify() { return ldc::verify::to_json(ldc::verify::run_all()).dump(); }
 
 namespace {
 // Reads the option object of run_experiment: every key must be consumed.

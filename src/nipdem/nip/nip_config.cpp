@@ -514,6 +514,21 @@ std::vector<CollisionReport> collision_report(const NipConfig& c) {
   return out;
 }
 
+nlohmann::json collision_json(const NipConfig& c) {
+  const auto ts = choose_time_step(c);
+  nlohmann::json j;
+  for (const auto& r : collision_report(c)) {
+    j[r.name] = {{"k_N_per_m", r.k}, {"gamma_Ns_per_m", r.gamma}, {"ks_N_per_m", r.ks}, {"restitution", r.restitution},
+                 {"contact_time_s", r.contact_time}, {"dt_max_s", r.dt_max_newmark}, {"dt_max_verlet_s", r.dt_max_verlet},
+                 {"gamma_thesis_convention_Ns_per_m", r.gamma_thesis}, {"reduced_mass_kg", r.m_red}};
+  }
+  j["stiffness_scale"] = c.stiffness_scale;
+  j["dt_s"] = ts.dt;
+  j["dt_bound_s"] = ts.bound;
+  j["dt_limited_by"] = ts.limiting;
+  return j;
+}
+
 TimeStep choose_time_step(const NipConfig& c) {
   const auto ia = make_interactions(c);
   // Smallest body: the smallest particle the size distribution can produce, with the

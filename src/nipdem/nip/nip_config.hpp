@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <toml++/toml.h>
 
 #include "nipdem/core/vec2.hpp"
@@ -148,6 +149,8 @@ struct CollisionReport {
   double gamma_thesis;  // gamma with eq. 2.2.7 as printed (Table 4.2 convention)
 };
 std::vector<CollisionReport> collision_report(const NipConfig& c);
+// `nipdem params collision --json`: the report per collision type and the time step chosen.
+nlohmann::json collision_json(const NipConfig& c);
 // Mass of a toner particle of volume-equivalent diameter d [kg].
 double toner_mass(const NipConfig& c, double d);
 // Engine interactions [toner_toner, toner_roller, toner_drum] with k scaled, gamma from e.

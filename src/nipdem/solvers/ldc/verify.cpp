@@ -252,4 +252,22 @@ Fig36 fig_3_6(int cells) {
           fd.potential(0), fd.potential(1)};
 }
 
+Report run_all() { return {table_3_1(), table_3_2(), table_3_3(), table_3_4(), fig_3_6()}; }
+
+nlohmann::json to_json(const Report& r) {
+  using json = nlohmann::json;
+  auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  json j;
+  j["table_3_1"] = json::array();
+  for (const auto& x : r.t31) j["table_3_1"].push_back({{"i", x.i}, {"kappa_eps0", x.kappa_eps0}, {"kappa_eps005", x.kappa_eps005}});
+  j["table_3_2"] = json::array();
+  for (const auto& x : r.t32) j["table_3_2"].push_back({{"H", x.H}, {"i", x.i}, {"delta", x.delta}, {"rho", opt(x.rho)}});
+  j["table_3_3"] = json::array();
+  for (const auto& x : r.t33) j["table_3_3"].push_back({{"H", x.H}, {"i", x.i}, {"kappa", x.kappa}, {"sigma", opt(x.sigma)}});
+  j["table_3_4"] = json::array();
+  for (const auto& x : r.t34) j["table_3_4"].push_back({{"i", x.i}, {"nu", x.nu}, {"tau", opt(x.tau)}});
+  j["fig_3_6"] = {{"charge_error_1", r.f36.charge_error_1}, {"charge_error_2", r.f36.charge_error_2}};
+  return j;
+}
+
 }  // namespace nipdem::ldc::verify

@@ -3,6 +3,8 @@
 // pointing out of the particle; in the physical convention of problem.hpp that is charge -q.
 #pragma once
 #include <optional>
+
+#include <nlohmann/json.hpp>
 #include <vector>
 
 namespace nipdem::ldc::verify {
@@ -64,5 +66,17 @@ SchwarzBounds schwarz_rate_bounds(int nodes = 1600);
 // charge_error_k = |Q_k - q_k|/|q_k| with Q_k the discrete flux through a node box around disc k.
 struct Fig36 { double charge_error_1, charge_error_2, g1, g2; };
 Fig36 fig_3_6(int cells = 80);
+
+// Everything `nipdem ldc verify` reports, computed once; to_json is its --json document (keys of
+// docs/cli-contract.md), shared by the CLI and the Python module.
+struct Report {
+  std::vector<Table31Row> t31;
+  std::vector<Table32Row> t32;
+  std::vector<Table33Row> t33;
+  std::vector<Table34Row> t34;
+  Fig36 f36;
+};
+Report run_all();
+nlohmann::json to_json(const Report& r);
 
 }  // namespace nipdem::ldc::verify
