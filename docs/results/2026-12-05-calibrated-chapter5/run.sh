@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Issue 17 items 3-4: chapter 5 rerun on the calibrated presets (r = 1.8, F_adh = 10 nN, 7.1 um
+# cut; docs/reduction.md), plus the 12-line edge study of the softening. Two lanes, one core each,
+# so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b)
+# Resumable: every experiment resumes its realizations from its --out folder, and a step whose
+# JSON exists is skipped. A step's wall time goes to walltimes.txt.
+set -euo pipefail
+lane=$1
+bin=${2:-$(cd "$(dirname "$0")" && pwd)/../../../build/nipdem}
+cd "$(dirname "$0")"
+ex=../../../examples
+FP="--set inflow.layer_thickness_m=60e-6 --set geometry.window_x_min_m=-400e-6 --set geometry.window_x_max_m=700e-6 --gap 100e-6,150e-6,200e-6 --sleeve-speed 10,30 --min-time 8e-3 --max-time 10e-3"
+step() {  # step NAME ARGS...: run `nipdem ARGS --out NAME --json` unless NAME.json exists
+  local name=$1; shift
+  [[ -s $name.json ]] && return 0
+  mkdir -p "$(dirname "$name")"
+  local t0; t0=$(date +%s)
+  if "$bin" "$@" --jobs 1 --out "$name" --json > "$name.json.tmp" 2> "$name.err"; then
+    mv "$name.json.tmp" "$name.json"
+    echo "$name $(( $(date +%s) - t0 )) s $("$bin" version | head -1)" >> walltimes.txt
+  else
+    echo "$name FAILED after $(( $(date +%s) - t0 )) s (see $name.err)" >> walltimes.txt
+  fi
+}
+edge_black="experiment edge-sharpness --config $ex/print_line_black.toml --line-start 0.1e-3 --line-length 0.15e-3 --margin 300e-6 --extra-time 0"
+case $lane in
+a)
+  # softening: 12 lines at stiffness_scale 0.03 (the same 12 seeds as lane b's 0.01)
+  step edge12/black_k0.03 $edge_black --realizations 12 --set collision.stiffness_scale=0.03
+  ;;
+b)
+  for s in 1 2 3; do
+    step front/color_s$s experiment front-position --preset color --seed $s --set collision.stiffness_scale=0.01 $FP
+  done
+  step vo/color experiment vo-level --config $ex/print_line_color.toml --set inflow.prefill=false --v0 0 \
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3
+  step edge12/black_k0.01 $edge_black --realizations 12 --set collision.stiffness_scale=0.01
+  ;;
+*) echo "usage: run.sh a|b [NIPDEM_BINARY]" >&2; exit 2 ;;
+esac
