@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 17 items 3-4: chapter 5 rerun on the calibrated presets (r = 1.8, F_adh = 10 nN, 7.1 um
 # cut; docs/reduction.md), plus the 12-line edge study of the softening. Two lanes, one core each,
-# so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b)
+# so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b: done; black | color: the chosen softening)
 # Resumable: every experiment resumes its realizations from its --out folder, and a step whose
 # JSON exists is skipped. A step's wall time goes to walltimes.txt.
 set -euo pipefail
@@ -22,6 +22,12 @@ step() {  # step NAME ARGS...: run `nipdem ARGS --out NAME --json` unless NAME.j
     echo "$name FAILED after $(( $(date +%s) - t0 )) s (see $name.err)" >> walltimes.txt
   fi
 }
+seed_edge() {  # seed_edge FROM TO: start a larger edge study from the realizations of a smaller one (same seeds)
+  local from=$1/edge_sharpness/realizations to=$2/edge_sharpness/realizations
+  [[ -d $from && ! -d $to ]] || return 0
+  mkdir -p "$to" && cp "$from"/*.json "$to"/
+}
+edge_color="experiment edge-sharpness --config $ex/print_line_color.toml --line-start 0.5e-3 --line-length 0.15e-3 --margin 300e-6 --extra-time 0"
 edge_black="experiment edge-sharpness --config $ex/print_line_black.toml --line-start 0.1e-3 --line-length 0.15e-3 --margin 300e-6 --extra-time 0"
 case $lane in
 a)
@@ -36,5 +42,32 @@ b)
     --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3
   step edge12/black_k0.01 $edge_black --realizations 12 --set collision.stiffness_scale=0.01
   ;;
-*) echo "usage: run.sh a|b [NIPDEM_BINARY]" >&2; exit 2 ;;
+# The chosen softening, stiffness_scale = 0.03 (the stiffness study, docs/results/2026-12-04-stiffness-study:
+# black's front moves 6.5 um = 5 standard errors between 0.01 and 0.1 and does not between 0.03 and 0.1).
+# One lane a unit. The 50-line edge studies start from the 12 lines already made at 0.03 (same seeds).
+black)
+  for s in 1 2 3; do
+    step front/black_k0.03_s$s experiment front-position --preset black --seed $s --set collision.stiffness_scale=0.03 $FP
+  done
+  step vo/black_k0.03 experiment vo-level --config $ex/print_line_black.toml --set inflow.prefill=false --v0 0 \
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.1e-3 --line-length 0.15e-3 --extra-time 1e-3 \
+    --set collision.stiffness_scale=0.03
+  seed_edge edge12/black_k0.03 edge50/black_k0.03
+  step edge50/black_k0.03 $edge_black --realizations 50 --set collision.stiffness_scale=0.03
+  ;;
+color)
+  for s in 1 2 3; do
+    step front/color_k0.03_s$s experiment front-position --preset color --seed $s --set collision.stiffness_scale=0.03 $FP
+  done
+  step vo/color_k0.03 experiment vo-level --config $ex/print_line_color.toml --set inflow.prefill=false --v0 0 \
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3 \
+    --set collision.stiffness_scale=0.03
+  step edge50/color_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03
+  # Table 5.1: the narrow and the fine toner (d5-d50-d95), the standard row being edge50/color_k0.03
+  step size/color_10_11_12_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03 \
+    --set toner.d_small_m=10e-6 --set toner.d50_m=11e-6 --set toner.d_large_m=12e-6
+  step size/color_6_9_12_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03 \
+    --set toner.d_small_m=6e-6 --set toner.d50_m=9e-6 --set toner.d_large_m=12e-6
+  ;;
+*) echo "usage: run.sh a|b|black|color [NIPDEM_BINARY]" >&2; exit 2 ;;
 esac
