@@ -1,5 +1,6 @@
 // `nipdem experiment front-position|reduction|vo-level|edge-sharpness` (CLI.md), and
-// `nipdem calibrate cohesion` (r fitted to a reduction speed over reduction experiments).
+// `nipdem calibrate cohesion` (r fitted to a reduction speed over reduction experiments) and
+// `nipdem calibrate cohesion-joint` (one r for several units from their cohesion reports).
 #include <memory>
 #include <sstream>
 
@@ -158,6 +159,17 @@ nipdem::cli::Register reg([](CLI::App& app) {
       }
       finish(c, "cohesion", [&] { return nipdem::calibrate::calibrate_cohesion_from_sweep(c->o, *sweep, t); });
     });
+  }
+  {
+    auto c = std::make_shared<Common>();
+    auto reports = std::make_shared<std::string>();
+    auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+    auto* sub = cal->add_subcommand("cohesion-joint", "One r for several units: joint chi2 over `calibrate cohesion --from-sweep` reports (§4.6; docs/reduction.md)");
+    sub->add_option("REPORTS", *reports, "comma-separated cohesion reports (JSON), one per unit; a unit is named by its file's stem")->required();
+    sub->add_option("--out", c->out, "output folder (default runs/cohesion-joint)");
+    sub->add_flag("--json", c->json, "print one JSON object on stdout");
+    sub->add_flag("--quiet", c->quiet, "no progress on stderr");
+    sub->callback([=] { finish(c, "cohesion-joint", [&] { return nipdem::calibrate::calibrate_cohesion_joint(c->o, *reports); }); });
   }
 });
 }  // namespace

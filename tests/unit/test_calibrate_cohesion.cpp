@@ -250,3 +250,100 @@ TEST(CohesionCounts, FromSweepPoolsSeveralFilesOfOneModelAndRefusesMixedOnes) {
   EXPECT_THROW(calibrate_cohesion_from_sweep(o, a + ",", t), InputError);
   fs::remove_all(dir);
 }
+
+// One r for several units (§4.6: the thesis chose one r for black and colour).
+namespace {
+// A unit whose mean count falls linearly, mean(r) = a - b r, with a constant standard error.
+JointUnit linear_unit(const char* name, double a, double b, double se, double target, double halfband) {
+  JointUnit u;
+  u.name = name;
+  for (double r : {0.0, 1.0, 2.0, 3.0}) u.rows.push_back({r, 2, a - b * r, se});
+  u.target = target;
+  u.target_lo = target - halfband;
+  u.target_hi = target + halfband;
+  return u;
+}
+}  // namespace
+
+TEST(CohesionJoint, TwoUnitsCrossingAtTheSameRGiveThatRAndTheAnalyticInterval) {
+  // Both units reach their target at r = 1; chi2(r) = 2 (50 (r - 1))^2 / (6^2 + 8^2), so
+  // chi2 = min + 1 at |r - 1| = 10 / (50 sqrt 2) = 0.14142. Tolerance: the grid step, 3/2e4.
+  const auto f = fit_joint_cohesion({linear_unit("black", 200, 50, 6, 150, 8), linear_unit("color", 160, 50, 8, 110, 6)});
+  const double h = 3.0 / 2e4;
+  EXPECT_NEAR(f.r_fit, 1.0, h);
+  EXPECT_NEAR(f.chi2_min, 0.0, 1e-6);
+  EXPECT_NEAR(f.r_lo, 1.0 - 0.1414214, h);
+  EXPECT_NEAR(f.r_hi, 1.0 + 0.1414214, h);
+  EXPECT_FALSE(f.open_lo);
+  EXPECT_FALSE(f.open_hi);
+  EXPECT_EQ(f.dof, 1u);
+  ASSERT_EQ(f.chi2_unit.size(), 2u);
+}
+
+TEST(CohesionJoint, DisagreeingUnitsMeetAtTheInverseVarianceWeightedRoot) {
+  // Unit A wants r = 1 with sigma_r = 10/50 = 0.2, unit B r = 2 with sigma_r = 0.1: the chi2
+  // minimum of two parabolas is the weighted mean (1/0.04 + 2/0.01) / (1/0.04 + 1/0.01) = 1.8,
+  // chi2_min = (2 - 1)^2 / (0.04 + 0.01) = 20, and the interval is 1.8 +- 1/sqrt(1/0.04 + 1/0.01).
+  const auto f = fit_joint_cohesion({linear_unit("a", 200, 50, 0, 150, 10), linear_unit("b", 200, 50, 0, 100, 5)});
+  const double h = 3.0 / 2e4;
+  EXPECT_NEAR(f.r_fit, 1.8, h);
+  EXPECT_NEAR(f.chi2_min, 20.0, 1e-2);
+  EXPECT_NEAR(f.r_hi - f.r_fit, 1.0 / std::sqrt(125.0), 2 * h);
+  EXPECT_NEAR(f.r_fit - f.r_lo, 1.0 / std::sqrt(125.0), 2 * h);
+  EXPECT_NEAR(f.chi2_unit[0], 0.64 / 0.04, 1e-2);  // (1.8 - 1)^2 / 0.2^2
+  EXPECT_NEAR(f.chi2_unit[1], 0.04 / 0.01, 1e-2);
+}
+
+TEST(CohesionJoint, BadInputIsRefusedNamingTheUnit) {
+  auto msg = [](std::vector<JointUnit> u) {
+    try {
+      fit_joint_cohesion(u);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const auto a = linear_unit("black", 200, 50, 6, 150, 8);
+  EXPECT_NE(msg({a}).find("at least two units"), std::string::npos);
+  auto nan_row = linear_unit("color", 160, 50, 8, 110, 6);
+  nan_row.rows[1].mean = NAN;
+  EXPECT_NE(msg({a, nan_row}).find("color"), std::string::npos);
+  auto no_error = linear_unit("color", 160, 50, 0, 110, 0);
+  EXPECT_NE(msg({a, no_error}).find("no error estimate"), std::string::npos);
+  auto apart = linear_unit("color", 160, 50, 8, 110, 6);
+  for (auto& r : apart.rows) r.r += 10.0;  // sweeps that do not overlap in r
+  EXPECT_NE(msg({a, apart}).find("overlap"), std::string::npos);
+  auto outside = linear_unit("color", 160, 50, 8, 110, 6);
+  outside.target = 50;  // outside [104, 116]
+  EXPECT_NE(msg({a, outside}).find("target_removed"), std::string::npos);
+}
+
+// The command reads `calibrate cohesion --from-sweep` reports; it reproduces the joint r of the
+// committed F10nN calibration (docs/results/2026-12-04-reduction-sweep-F10nN/joint_r.json,
+// made by joint_fit.py on a 1e-3 grid: r = 1.768, interval 1.514-2.026, chi2 0.616).
+TEST(CohesionJoint, ReproducesTheCommittedPresetCalibration) {
+  namespace fs = std::filesystem;
+  const fs::path src = fs::path(NIPDEM_SOURCE_DIR) / "docs/results/2026-12-04-reduction-sweep-F10nN/calibration";
+  const fs::path dir = fs::temp_directory_path() / ("nipdem_cohesion_joint_" + std::to_string(::getpid()));
+  experiments::ExperimentOptions o;
+  o.out = dir;
+  o.progress = false;
+  const auto j = calibrate_cohesion_joint(o, (src / "black.json").string() + "," + (src / "color.json").string());
+  EXPECT_NEAR(j["r_fit"].get<double>(), 1.768, 2e-3);  // 2e-3: the Python grid's step plus ours
+  EXPECT_NEAR(j["r_interval_dchi2_1"][0].get<double>(), 1.514, 2e-3);
+  EXPECT_NEAR(j["r_interval_dchi2_1"][1].get<double>(), 2.026, 2e-3);
+  EXPECT_NEAR(j["chi2_min"].get<double>(), 0.616, 2e-3);
+  EXPECT_TRUE(j["units"].contains("black"));
+  EXPECT_TRUE(j["units"].contains("color"));
+  EXPECT_TRUE(fs::exists(dir / "removed_vs_r.png"));
+  EXPECT_TRUE(fs::exists(dir / "cohesion_joint.csv"));
+  // a reduction sweep JSON is not a cohesion report
+  const fs::path sweep = fs::path(NIPDEM_SOURCE_DIR) / "docs/results/2026-12-04-reduction-sweep-F10nN/color_s1/reduction.json";
+  try {
+    calibrate_cohesion_joint(o, (src / "black.json").string() + "," + sweep.string());
+    ADD_FAILURE() << "a sweep was read as a report";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reduction.json"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <array>
+#include <filesystem>
+#include <limits>
 #include <map>
+#include <tuple>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -17,7 +21,16 @@ namespace nipdem::calibrate {
 using nlohmann::json;
 namespace {
 const char* kWhere = "calibrate cohesion";
+
+// Mean and standard error at r, linear between the swept r of `rows` (sorted by r, >= 2 rows);
+// `seg` is the segment to start from and is advanced (calls with growing r walk the rows once).
+std::pair<double, double> interp_rows(const std::vector<CountRow>& rows, double r, std::size_t& seg) {
+  while (seg + 2 < rows.size() && r > rows[seg + 1].r) ++seg;
+  const CountRow &a = rows[seg], &b = rows[seg + 1];
+  const double w = (r - a.r) / (b.r - a.r);
+  return {a.mean + w * (b.mean - a.mean), a.stderr_ + w * (b.stderr_ - a.stderr_)};
 }
+}  // namespace
 
 CohesionFit fit_cohesion_ratio(std::vector<SpeedPoint> pts, double target) {
   if (pts.size() < 2) throw_input(kWhere, "points", std::to_string(pts.size()), "need at least two reduction speeds");
@@ -170,10 +183,7 @@ CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const C
   std::size_t seg = 0;
   for (int k = 0; k <= kGrid; ++k) {
     const double r = k == kGrid ? r1 : r0 + (r1 - r0) * double(k) / kGrid;
-    while (seg + 2 < R.size() && r > R[seg + 1].r) ++seg;
-    const double w = (r - R[seg].r) / (R[seg + 1].r - R[seg].r);
-    const double m = R[seg].mean + w * (R[seg + 1].mean - R[seg].mean);
-    const double e = R[seg].stderr_ + w * (R[seg + 1].stderr_ - R[seg].stderr_);
+    const auto [m, e] = interp_rows(R, r, seg);
     if (m - e <= f.target_hi && m + e >= f.target_lo) {
       if (!f.in_band) f.r_lo = r;
       f.in_band = true;
@@ -307,6 +317,188 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
     j["r_1sigma_open"] = {f.open_lo, f.open_hi};
   }
   return j;
+}
+
+JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units_in) {
+  const char* where = "calibrate cohesion-joint";
+  if (units_in.size() < 2) throw_input(where, "reports", std::to_string(units_in.size()), "a joint fit needs at least two units");
+  std::vector<JointUnit> units = units_in;
+  JointCohesionFit f;
+  f.r_min = -std::numeric_limits<double>::infinity();
+  f.r_max = std::numeric_limits<double>::infinity();
+  for (auto& u : units) {
+    std::sort(u.rows.begin(), u.rows.end(), [](const CountRow& a, const CountRow& b) { return a.r < b.r; });
+    if (u.rows.size() < 2) throw_input(u.name, "rows", std::to_string(u.rows.size()), "need at least two swept r");
+    for (std::size_t i = 0; i < u.rows.size(); ++i) {
+      const auto& row = u.rows[i];
+      if (!std::isfinite(row.r) || row.r < 0.0 || !std::isfinite(row.mean) || row.mean < 0.0 || !std::isfinite(row.stderr_) || row.stderr_ < 0.0)
+        throw_input(u.name, fmt::format("rows[{}]", i), fmt::format("r {:g}, mean {:g}, stderr {:g}", row.r, row.mean, row.stderr_), "must be finite and >= 0");
+      if (i > 0 && !(row.r > u.rows[i - 1].r)) throw_input(u.name, fmt::format("rows[{}].r", i), fmt::format("{:g}", row.r), "every r must be distinct");
+    }
+    if (!std::isfinite(u.target) || !std::isfinite(u.target_lo) || !std::isfinite(u.target_hi) || !(u.target_lo <= u.target && u.target <= u.target_hi))
+      throw_input(u.name, "target_removed", fmt::format("{:g} in [{:g}, {:g}]", u.target, u.target_lo, u.target_hi), "finite, inside its range");
+    f.r_min = std::max(f.r_min, u.rows.front().r);
+    f.r_max = std::min(f.r_max, u.rows.back().r);
+  }
+  if (!(f.r_max > f.r_min))
+    throw_input(where, "rows", fmt::format("common r range [{:g}, {:g}]", f.r_min, f.r_max), "the units' sweeps must overlap in r");
+  constexpr int kGrid = 20000;  // step (r_max - r_min) / 2e4: 1.5e-4 for a sweep to r = 3
+  std::vector<std::size_t> seg(units.size(), 0);
+  f.chi2_min = std::numeric_limits<double>::infinity();
+  std::vector<double> chi2(kGrid + 1);
+  for (int k = 0; k <= kGrid; ++k) {
+    const double r = k == kGrid ? f.r_max : f.r_min + (f.r_max - f.r_min) * double(k) / kGrid;
+    double c = 0.0;
+    for (std::size_t u = 0; u < units.size(); ++u) {
+      const auto [m, e] = interp_rows(units[u].rows, r, seg[u]);
+      const double hb = 0.5 * (units[u].target_hi - units[u].target_lo);
+      const double var = e * e + hb * hb;
+      if (!(var > 0.0))
+        throw_input(units[u].name, "rows", fmt::format("r = {:g}", r), "no error estimate there (one seed and no target range): pool a second seed or give the band");
+      c += (m - units[u].target) * (m - units[u].target) / var;
+    }
+    chi2[k] = c;
+    if (c < f.chi2_min) { f.chi2_min = c; f.r_fit = r; }
+  }
+  bool any = false;
+  for (int k = 0; k <= kGrid; ++k) {
+    const double r = k == kGrid ? f.r_max : f.r_min + (f.r_max - f.r_min) * double(k) / kGrid;
+    if (k % 100 == 0 || k == kGrid) f.curve.emplace_back(r, chi2[k]);
+    if (chi2[k] <= f.chi2_min + 1.0) {
+      if (!any) f.r_lo = r;
+      any = true;
+      f.r_hi = r;
+    }
+  }
+  f.open_lo = f.r_lo <= f.r_min;
+  f.open_hi = f.r_hi >= f.r_max;
+  for (auto& u : units) {
+    std::size_t s0 = 0;
+    const auto [m, e] = interp_rows(u.rows, f.r_fit, s0);
+    const double hb = 0.5 * (u.target_hi - u.target_lo);
+    f.chi2_unit.push_back((m - u.target) * (m - u.target) / (e * e + hb * hb));
+  }
+  f.dof = units.size() - 1;
+  return f;
+}
+
+json calibrate_cohesion_joint(const experiments::ExperimentOptions& o, const std::string& report_list) {
+  const char* where = "calibrate cohesion-joint";
+  std::vector<std::string> files;
+  for (std::size_t a = 0; a <= report_list.size();) {
+    const std::size_t b = std::min(report_list.find(',', a), report_list.size());
+    if (b == a) throw_input(where, "REPORTS", report_list, "empty file name in the comma-separated list");
+    files.push_back(report_list.substr(a, b - a));
+    a = b + 1;
+  }
+  std::vector<JointUnit> units;
+  std::vector<json> reps;
+  for (const auto& file : files) {
+    json rep;
+    try {
+      rep = json::parse(io::read_file(file));
+    } catch (const json::exception& e) {
+      throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
+    }
+    if (!rep.is_object() || rep.value("calibration", std::string()) != "cohesion" || !rep.contains("rows") || !rep["rows"].is_array())
+      throw_input(file, "calibration", "", "expected the JSON report of `nipdem calibrate cohesion --from-sweep` (\"calibration\": \"cohesion\", \"rows\": [...])");
+    JointUnit u;
+    u.name = std::filesystem::path(file).stem().string();
+    for (const auto& other : units)
+      if (other.name == u.name) throw_input(file, "REPORTS", u.name, "two reports with the same file name: a unit is named by its file's stem");
+    std::size_t k = 0;
+    for (const auto& row : rep["rows"]) {
+      for (const char* key : {"r", "removed_mean", "removed_stderr"})
+        if (!row.is_object() || !row.contains(key) || !row[key].is_number()) throw_input(file, fmt::format("rows[{}].{}", k, key), "", "missing or not a number");
+      u.rows.push_back({row["r"].get<double>(), row.value("seeds", std::size_t{0}), row["removed_mean"].get<double>(), row["removed_stderr"].get<double>()});
+      ++k;
+    }
+    const json& tr = rep.contains("target_removed_range") ? rep["target_removed_range"] : json();
+    if (!rep.contains("target_removed") || !rep["target_removed"].is_number() || !tr.is_array() || tr.size() != 2 || !tr[0].is_number() || !tr[1].is_number())
+      throw_input(file, "target_removed", "", "missing: target_removed (number) and target_removed_range ([lo, hi]) are required");
+    u.target = rep["target_removed"].get<double>();
+    u.target_lo = tr[0].get<double>();
+    u.target_hi = tr[1].get<double>();
+    units.push_back(std::move(u));
+    reps.push_back(std::move(rep));
+  }
+  const JointCohesionFit f = fit_joint_cohesion(units);
+
+  std::vector<std::vector<double>> curve_csv;
+  for (const auto& [r, c] : f.curve) curve_csv.push_back({r, c});
+  io::write_csv(o.out / "cohesion_joint.csv", {"r", "chi2"}, curve_csv, {"{:.6g}", "{:.8g}"});
+  std::vector<std::string> cols{"unit", "r", "seeds", "removed_mean", "removed_stderr"};
+  std::vector<std::vector<std::string>> rows_csv;
+  io::PlotSpec plot;
+  plot.title = "One cohesion ratio for every unit (§4.6, fig. 4.25 analogue; Table 4.3 bands)";
+  plot.x_label = "r = F_coh / F_adh";
+  plot.y_label = "toner removed from the pile in the observation time";
+  double y_top = 0.0;
+  // a unit's points and its band share a colour (black for the black unit, as in fig. 4.25)
+  const std::array<std::array<double, 3>, 4> kUnitColours{{{0.1, 0.1, 0.1}, {0.12, 0.47, 0.71}, {0.58, 0.40, 0.74}, {0.17, 0.63, 0.17}}};
+  for (std::size_t ui = 0; ui < units.size(); ++ui) {
+    const auto& u = units[ui];
+    const auto colour = u.name == "black" ? kUnitColours[0] : kUnitColours[1 + ui % 3];
+    io::Series s;
+    s.color = colour;
+    s.label = u.name + ": mean over seeds (± standard error)";
+    s.markers = true;
+    s.line_only_if_resolved = true;
+    for (const auto& row : u.rows) {
+      s.x.push_back(row.r);
+      s.y.push_back(row.mean);
+      s.y_err.push_back(row.stderr_);
+      y_top = std::max(y_top, row.mean + row.stderr_);
+      rows_csv.push_back({u.name, fmt::format("{:.6g}", row.r), std::to_string(row.n), fmt::format("{:.8g}", row.mean), fmt::format("{:.8g}", row.stderr_)});
+    }
+    plot.series.push_back(s);
+    for (auto [y, lab] : {std::pair{u.target_lo, u.name + ": Table 4.3 band"}, std::pair{u.target_hi, std::string()}}) {
+      io::Series b;
+      b.label = lab;
+      b.x = {u.rows.front().r, u.rows.back().r};
+      b.y = {y, y};
+      b.dashed = true;
+      b.line_width = 1.0;
+      b.color = colour;
+      plot.series.push_back(b);
+    }
+  }
+  io::write_file_atomic(o.out / "removed_vs_r.csv", io::format_csv_cells(cols, rows_csv));
+  for (auto [x, lab, dashed] : {std::tuple{f.r_fit, fmt::format("joint r = {:.3g}", f.r_fit), false},
+                                std::tuple{f.r_lo, fmt::format("chi2 <= min + 1: {:.3g}-{:.3g}", f.r_lo, f.r_hi), true},
+                                std::tuple{f.r_hi, std::string(), true}}) {
+    io::Series v;
+    v.label = lab;
+    v.x = {x, x};
+    v.y = {0.0, y_top};
+    v.dashed = dashed;
+    v.color = std::array<double, 3>{0.85, 0.45, 0.0};
+    plot.series.push_back(v);
+  }
+  io::write_plot_png(o.out / "removed_vs_r.png", plot);
+
+  json per_unit = json::object();
+  for (std::size_t u = 0; u < units.size(); ++u) {
+    json pu{{"report", files[u]}, {"chi2_at_r_fit", f.chi2_unit[u]}, {"target_removed", units[u].target},
+            {"target_removed_range", {units[u].target_lo, units[u].target_hi}}};
+    for (const char* key : {"r_fit", "r_1sigma", "sweeps"})
+      if (reps[u].contains(key)) pu[key] = reps[u][key];
+    per_unit[units[u].name] = pu;
+  }
+  return json{{"calibration", "cohesion-joint"},
+              {"method", "chi2 over the units of the pooled reduction-sweep counts, mean and stderr linear between the swept r; interval chi2 <= min + 1"},
+              {"reports", files},
+              {"r_fit", f.r_fit},
+              {"r_interval_dchi2_1", {f.r_lo, f.r_hi}},
+              {"r_interval_open", {f.open_lo, f.open_hi}},
+              {"r_range_searched", {f.r_min, f.r_max}},
+              {"chi2_min", f.chi2_min},
+              {"dof", f.dof},
+              {"units", per_unit},
+              {"csv", (o.out / "cohesion_joint.csv").string()},
+              {"rows_csv", (o.out / "removed_vs_r.csv").string()},
+              {"plot", (o.out / "removed_vs_r.png").string()},
+              {"meta", {{"git_hash", kGitHash}}}};
 }
 
 json calibrate_cohesion(const experiments::ExperimentOptions& o, const CohesionOptions& c) {

@@ -16,6 +16,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -114,6 +115,38 @@ CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const C
 // OUT/cohesion.{csv,png} and returns the report (no simulation is run).
 nlohmann::json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& sweep_json,
                                              const CountTarget& target);
+
+// ---- one r for several units (the thesis chose one r for black and colour, §4.6) ----
+// Each unit is the pooled count fit of its own sweep (a `calibrate cohesion --from-sweep`
+// report: rows of mean and standard error over seeds at each swept r, and the Table 4.3 band as
+// counts). The joint r minimises
+//   chi2(r) = sum_u (mean_u(r) - target_u)^2 / (stderr_u(r)^2 + halfband_u^2),
+// mean and stderr linear between the swept r as in fit_cohesion_from_counts, on the r range
+// every unit covers; the interval is chi2 <= chi2_min + 1 (one fitted parameter).
+struct JointUnit {
+  std::string name;
+  std::vector<CountRow> rows;                 // at least two distinct r, sorted or not
+  double target = 0, target_lo = 0, target_hi = 0;  // removed toner (counts)
+};
+struct JointCohesionFit {
+  double r_fit = 0;
+  double r_lo = 0, r_hi = 0;               // chi2 <= chi2_min + 1
+  bool open_lo = false, open_hi = false;   // the interval reaches an end of the common range
+  double r_min = 0, r_max = 0;             // the common range searched
+  double chi2_min = 0;
+  std::vector<double> chi2_unit;           // each unit's term at r_fit
+  std::size_t dof = 0;                     // units - 1
+  std::vector<std::pair<double, double>> curve;  // (r, chi2) on the search grid
+};
+// Throws InputError for fewer than two units, a unit with fewer than two r, non-finite or
+// negative values, a target outside its band, no common r range, or a zero denominator (one seed
+// and no band at some r: no error estimate).
+JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units);
+
+// `calibrate cohesion-joint REPORT,REPORT,...`: reads `calibrate cohesion --from-sweep` JSON
+// reports (a unit is named by its file's stem), fits, writes OUT/cohesion_joint.csv (chi2 curve),
+// OUT/removed_vs_r.csv and OUT/removed_vs_r.png (fig. 4.25 analogue) and returns the report.
+nlohmann::json calibrate_cohesion_joint(const experiments::ExperimentOptions& o, const std::string& report_list);
 
 // Runs the rounds (threads only: each round depends on the last) and returns the JSON report
 // (CLI.md keys: r_fit, bracket, points, rounds, ...). Writes OUT/cohesion.csv and
