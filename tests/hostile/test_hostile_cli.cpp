@@ -218,6 +218,30 @@ TEST(HostileCli, DamagedDataFilesAreRefusedNamingTheFile) {
   const std::string pattern_cfg = write(d / "pattern.toml", pat);
   const std::string rc = write(d / "rc.csv", "frequency_Hz,amplitude_V,phase_deg\n100,1,");
   const std::string out = " --quiet --out " + (d / "o").string();
+  // cohesion reports for `calibrate cohesion-joint`: truncated, a negative count, a string number,
+  // r = 1e308, and a reduction sweep where a report belongs
+  const std::string report_dir = kSrc + "/docs/results/2026-12-04-reduction-sweep-F10nN/";
+  const std::string report = nipdem::io::read_file(report_dir + "calibration/color.json");
+  const std::string good_report = report_dir + "calibration/black.json";
+  const std::string rep_trunc = write(d / "rep_trunc.json", report.substr(0, report.size() / 2));
+  auto rep_with = [&](const char* name, const std::string& from, const std::string& to) {
+    std::string t = report;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    return write(d / name, t);
+  };
+  const std::string rep_neg = rep_with("rep_neg.json", "\"removed_mean\":8.0", "\"removed_mean\":-8.0");
+  const std::string rep_str = rep_with("rep_str.json", "\"removed_mean\":8.0", "\"removed_mean\":\"8\"");
+  const std::string rep_huge = rep_with("rep_huge.json", "\"r\":3.0", "\"r\":1e308");
+  expect_refused({
+      {"calibrate cohesion-joint " + good_report + "," + rep_trunc + out, {"rep_trunc.json", "not a JSON document"}},
+      {"calibrate cohesion-joint " + good_report + "," + rep_neg + out, {"rep_neg", "rows[0]", ">= 0"}},
+      {"calibrate cohesion-joint " + good_report + "," + rep_str + out, {"rep_str.json", "removed_mean"}},
+      {"calibrate cohesion-joint " + good_report + "," + report_dir + "color_s1/reduction.json" + out, {"reduction.json", "cohesion"}},
+      {"calibrate cohesion-joint " + good_report + "," + rep_huge + out, {"rep_huge", "rows[6]", "1e+06"}},
+      {"calibrate cohesion-joint " + good_report + "," + good_report + out, {"same file name"}},
+  }, "hostile_cohesion");
   expect_refused({
       {"field probe --x 0 --y 1e-4 --map " + truncated, {"truncated.csv"}},
       {"field probe --x 0 --y 1e-4 --map " + with_nan, {"nan.csv:3", "NaN"}},

@@ -321,6 +321,7 @@ json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, cons
 
 JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units_in) {
   const char* where = "calibrate cohesion-joint";
+  constexpr double kMaxR = 1e6;
   if (units_in.size() < 2) throw_input(where, "reports", std::to_string(units_in.size()), "a joint fit needs at least two units");
   std::vector<JointUnit> units = units_in;
   JointCohesionFit f;
@@ -328,15 +329,18 @@ JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units_in) {
   f.r_max = std::numeric_limits<double>::infinity();
   for (auto& u : units) {
     std::sort(u.rows.begin(), u.rows.end(), [](const CountRow& a, const CountRow& b) { return a.r < b.r; });
-    if (u.rows.size() < 2) throw_input(u.name, "rows", std::to_string(u.rows.size()), "need at least two swept r");
+    if (u.rows.size() < 2) throw_input(u.source.empty() ? u.name : u.source, "rows", std::to_string(u.rows.size()), "need at least two swept r");
     for (std::size_t i = 0; i < u.rows.size(); ++i) {
       const auto& row = u.rows[i];
-      if (!std::isfinite(row.r) || row.r < 0.0 || !std::isfinite(row.mean) || row.mean < 0.0 || !std::isfinite(row.stderr_) || row.stderr_ < 0.0)
-        throw_input(u.name, fmt::format("rows[{}]", i), fmt::format("r {:g}, mean {:g}, stderr {:g}", row.r, row.mean, row.stderr_), "must be finite and >= 0");
-      if (i > 0 && !(row.r > u.rows[i - 1].r)) throw_input(u.name, fmt::format("rows[{}].r", i), fmt::format("{:g}", row.r), "every r must be distinct");
+      // r beyond 1e6 is no cohesion ratio a sweep meant (the thesis's range is 0-1000); it would
+      // stretch the last segment's interpolation silently
+      if (!std::isfinite(row.r) || row.r < 0.0 || row.r > kMaxR || !std::isfinite(row.mean) || row.mean < 0.0 || !std::isfinite(row.stderr_) || row.stderr_ < 0.0)
+        throw_input(u.source.empty() ? u.name : u.source, fmt::format("rows[{}]", i), fmt::format("r {:g}, mean {:g}, stderr {:g}", row.r, row.mean, row.stderr_),
+                    fmt::format("r in [0, {:g}], mean and stderr finite and >= 0", kMaxR));
+      if (i > 0 && !(row.r > u.rows[i - 1].r)) throw_input(u.source.empty() ? u.name : u.source, fmt::format("rows[{}].r", i), fmt::format("{:g}", row.r), "every r must be distinct");
     }
     if (!std::isfinite(u.target) || !std::isfinite(u.target_lo) || !std::isfinite(u.target_hi) || !(u.target_lo <= u.target && u.target <= u.target_hi))
-      throw_input(u.name, "target_removed", fmt::format("{:g} in [{:g}, {:g}]", u.target, u.target_lo, u.target_hi), "finite, inside its range");
+      throw_input(u.source.empty() ? u.name : u.source, "target_removed", fmt::format("{:g} in [{:g}, {:g}]", u.target, u.target_lo, u.target_hi), "finite, inside its range");
     f.r_min = std::max(f.r_min, u.rows.front().r);
     f.r_max = std::min(f.r_max, u.rows.back().r);
   }
@@ -354,7 +358,7 @@ JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units_in) {
       const double hb = 0.5 * (units[u].target_hi - units[u].target_lo);
       const double var = e * e + hb * hb;
       if (!(var > 0.0))
-        throw_input(units[u].name, "rows", fmt::format("r = {:g}", r), "no error estimate there (one seed and no target range): pool a second seed or give the band");
+        throw_input(units[u].source.empty() ? units[u].name : units[u].source, "rows", fmt::format("r = {:g}", r), "no error estimate there (one seed and no target range): pool a second seed or give the band");
       c += (m - units[u].target) * (m - units[u].target) / var;
     }
     chi2[k] = c;
@@ -404,6 +408,7 @@ json calibrate_cohesion_joint(const experiments::ExperimentOptions& o, const std
       throw_input(file, "calibration", "", "expected the JSON report of `nipdem calibrate cohesion --from-sweep` (\"calibration\": \"cohesion\", \"rows\": [...])");
     JointUnit u;
     u.name = std::filesystem::path(file).stem().string();
+    u.source = file;
     for (const auto& other : units)
       if (other.name == u.name) throw_input(file, "REPORTS", u.name, "two reports with the same file name: a unit is named by its file's stem");
     std::size_t k = 0;

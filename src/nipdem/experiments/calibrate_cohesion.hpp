@@ -125,6 +125,7 @@ nlohmann::json calibrate_cohesion_from_sweep(const experiments::ExperimentOption
 // every unit covers; the interval is chi2 <= chi2_min + 1 (one fitted parameter).
 struct JointUnit {
   std::string name;
+  std::string source;                         // where the rows came from (error messages); name if empty
   std::vector<CountRow> rows;                 // at least two distinct r, sorted or not
   double target = 0, target_lo = 0, target_hi = 0;  // removed toner (counts)
 };
