@@ -27,6 +27,16 @@ seed_edge() {  # seed_edge FROM TO: start a larger edge study from the realizati
   [[ -d $from && ! -d $to ]] || return 0
   mkdir -p "$to" && cp "$from"/*.json "$to"/
 }
+K=0.03  # the chosen softening (lanes black and color)
+front_and_vo() {  # front_and_vo PRESET LINE_START: front position (3 seeds) and Vo-level (3 seeds) at K
+  local p=$1
+  for s in 1 2 3; do
+    step front/${p}_k${K}_s$s experiment front-position --preset $p --seed $s --set collision.stiffness_scale=$K $FP
+  done
+  step vo/${p}_k$K experiment vo-level --config $ex/print_line_$p.toml --set inflow.prefill=false --v0 0 \
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start $2 --line-length 0.15e-3 --extra-time 1e-3 \
+    --set collision.stiffness_scale=$K
+}
 edge_color="experiment edge-sharpness --config $ex/print_line_color.toml --line-start 0.5e-3 --line-length 0.15e-3 --margin 300e-6 --extra-time 0"
 edge_black="experiment edge-sharpness --config $ex/print_line_black.toml --line-start 0.1e-3 --line-length 0.15e-3 --margin 300e-6 --extra-time 0"
 case $lane in
@@ -38,35 +48,25 @@ b)
   for s in 1 2 3; do
     step front/color_s$s experiment front-position --preset color --seed $s --set collision.stiffness_scale=0.01 $FP
   done
+  # (ran when the example said stiffness_scale = 0.01; the --set keeps this line true since it says 0.03)
   step vo/color experiment vo-level --config $ex/print_line_color.toml --set inflow.prefill=false --v0 0 \
-    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3 \
+    --set collision.stiffness_scale=0.01
   step edge12/black_k0.01 $edge_black --realizations 12 --set collision.stiffness_scale=0.01
   ;;
 # The chosen softening, stiffness_scale = 0.03 (the stiffness study, docs/results/2026-12-04-stiffness-study:
-# black's front moves 6.5 um = 5 standard errors between 0.01 and 0.1 and does not between 0.03 and 0.1).
+# black's front moves 3.6 sigma between 0.01 and 0.1 and 0.6 sigma between 0.03 and 0.1).
 # One lane a unit. The 50-line edge studies start from the 12 lines already made at 0.03 (same seeds).
-black)
-  for s in 1 2 3; do
-    step front/black_k0.03_s$s experiment front-position --preset black --seed $s --set collision.stiffness_scale=0.03 $FP
-  done
-  step vo/black_k0.03 experiment vo-level --config $ex/print_line_black.toml --set inflow.prefill=false --v0 0 \
-    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.1e-3 --line-length 0.15e-3 --extra-time 1e-3 \
-    --set collision.stiffness_scale=0.03
-  seed_edge edge12/black_k0.03 edge50/black_k0.03
-  step edge50/black_k0.03 $edge_black --realizations 50 --set collision.stiffness_scale=0.03
+black) front_and_vo black 0.1e-3
+  seed_edge edge12/black_k$K edge50/black_k$K
+  step edge50/black_k$K $edge_black --realizations 50 --set collision.stiffness_scale=$K
   ;;
-color)
-  for s in 1 2 3; do
-    step front/color_k0.03_s$s experiment front-position --preset color --seed $s --set collision.stiffness_scale=0.03 $FP
-  done
-  step vo/color_k0.03 experiment vo-level --config $ex/print_line_color.toml --set inflow.prefill=false --v0 0 \
-    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3 \
-    --set collision.stiffness_scale=0.03
-  step edge50/color_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03
+color) front_and_vo color 0.5e-3
+  step edge50/color_k$K $edge_color --realizations 50 --set collision.stiffness_scale=$K
   # Table 5.1: the narrow and the fine toner (d5-d50-d95), the standard row being edge50/color_k0.03
-  step size/color_10_11_12_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03 \
+  step size/color_10_11_12_k$K $edge_color --realizations 50 --set collision.stiffness_scale=$K \
     --set toner.d_small_m=10e-6 --set toner.d50_m=11e-6 --set toner.d_large_m=12e-6
-  step size/color_6_9_12_k0.03 $edge_color --realizations 50 --set collision.stiffness_scale=0.03 \
+  step size/color_6_9_12_k$K $edge_color --realizations 50 --set collision.stiffness_scale=$K \
     --set toner.d_small_m=6e-6 --set toner.d50_m=9e-6 --set toner.d_large_m=12e-6
   ;;
 *) echo "usage: run.sh a|b|black|color [NIPDEM_BINARY]" >&2; exit 2 ;;

@@ -30,6 +30,26 @@ std::pair<double, double> interp_rows(const std::vector<CountRow>& rows, double 
   const double w = (r - a.r) / (b.r - a.r);
   return {a.mean + w * (b.mean - a.mean), a.stderr_ + w * (b.stderr_ - a.stderr_)};
 }
+
+// "a.json,b.json" -> {"a.json", "b.json"}; an empty name is an InputError naming `option`.
+std::vector<std::string> split_file_list(const std::string& list, const char* where, const char* option) {
+  std::vector<std::string> files;
+  for (std::size_t a = 0; a <= list.size();) {
+    const std::size_t b = std::min(list.find(',', a), list.size());
+    if (b == a) throw_input(where, option, list, "empty file name in the comma-separated list");
+    files.push_back(list.substr(a, b - a));
+    a = b + 1;
+  }
+  return files;
+}
+
+json read_json_file(const std::string& file) {
+  try {
+    return json::parse(io::read_file(file));
+  } catch (const json::exception& e) {
+    throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
+  }
+}
 }  // namespace
 
 CohesionFit fit_cohesion_ratio(std::vector<SpeedPoint> pts, double target) {
@@ -204,23 +224,12 @@ CountFit fit_cohesion_from_counts(const std::vector<CountPoint>& points, const C
 json calibrate_cohesion_from_sweep(const experiments::ExperimentOptions& o, const std::string& file_list, const CountTarget& target) {
   // Several sweeps (e.g. one per seed, run separately) are pooled: comma-separated files of the
   // same preset, model (--set overrides) and observation time.
-  std::vector<std::string> files;
-  for (std::size_t a = 0; a <= file_list.size();) {
-    const std::size_t b = std::min(file_list.find(',', a), file_list.size());
-    if (b == a) throw_input("calibrate cohesion", "--from-sweep", file_list, "empty file name in the comma-separated list");
-    files.push_back(file_list.substr(a, b - a));
-    a = b + 1;
-  }
+  const std::vector<std::string> files = split_file_list(file_list, kWhere, "--from-sweep");
   std::vector<CountPoint> pts;
   double T = -1.0, width = -1.0;
   json first_meta;
   for (const auto& file : files) {
-    json rep;
-    try {
-      rep = json::parse(io::read_file(file));
-    } catch (const json::exception& e) {
-      throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
-    }
+    json rep = read_json_file(file);
     if (!rep.is_object() || rep.value("experiment", std::string()) != "reduction" || !rep.contains("points") || !rep["points"].is_array())
       throw_input(file, "experiment", "", "expected the JSON written by `nipdem experiment reduction` (\"experiment\": \"reduction\", \"points\": [...])");
     if (rep.contains("meta") && rep["meta"].is_object()) {
@@ -388,22 +397,11 @@ JointCohesionFit fit_joint_cohesion(const std::vector<JointUnit>& units_in) {
 
 json calibrate_cohesion_joint(const experiments::ExperimentOptions& o, const std::string& report_list) {
   const char* where = "calibrate cohesion-joint";
-  std::vector<std::string> files;
-  for (std::size_t a = 0; a <= report_list.size();) {
-    const std::size_t b = std::min(report_list.find(',', a), report_list.size());
-    if (b == a) throw_input(where, "REPORTS", report_list, "empty file name in the comma-separated list");
-    files.push_back(report_list.substr(a, b - a));
-    a = b + 1;
-  }
+  const std::vector<std::string> files = split_file_list(report_list, where, "REPORTS");
   std::vector<JointUnit> units;
   std::vector<json> reps;
   for (const auto& file : files) {
-    json rep;
-    try {
-      rep = json::parse(io::read_file(file));
-    } catch (const json::exception& e) {
-      throw_input(file, "(JSON)", "", std::string("not a JSON document: ") + e.what());
-    }
+    json rep = read_json_file(file);
     if (!rep.is_object() || rep.value("calibration", std::string()) != "cohesion" || !rep.contains("rows") || !rep["rows"].is_array())
       throw_input(file, "calibration", "", "expected the JSON report of `nipdem calibrate cohesion --from-sweep` (\"calibration\": \"cohesion\", \"rows\": [...])");
     JointUnit u;
