@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "fuzz_common.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/checkpoint_file.hpp"
 
 namespace {

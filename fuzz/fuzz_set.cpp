@@ -3,8 +3,8 @@
 #include <vector>
 
 #include "fuzz_common.hpp"
-#include "nipdem/experiments/nip_config.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip_config.hpp"
+#include "nipdem/nip/presets.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string preset = nipdem::experiments::preset_text("black");
