@@ -226,6 +226,18 @@ class Options {
   json j_;
   std::set<std::string> used_;
 };
+
+// The printed line of vo-level and edge-sharpness (experiments/print_line.hpp).
+void get_print(Options& op, experiments::PrintOptions& p) {
+  op.get("line_length_m", p.line_length_m);
+  op.get("line_start_m", p.line_start_m);
+  op.get("extra_time_s", p.extra_time_s);
+}
+// The CLI checks --extra-time while parsing (CLI::Range(0.0, 1.0)); the same range, after finish().
+void check_extra_time(const std::string& where, const experiments::PrintOptions& p) {
+  if (!(p.extra_time_s >= 0.0 && p.extra_time_s <= 1.0))
+    throw_input(where, "--extra-time", fmt::format("{:g}", p.extra_time_s), "out of range", "[0, 1]");
+}
 }  // namespace
 
 std::string run_experiment(const std::string& name, const std::string& options) {
@@ -267,24 +279,18 @@ std::string run_experiment(const std::string& name, const std::string& options) 
     op.get("v0_V", v.v0_V);
     op.get("v_max_V", v.v_max_V);
     op.get("seeds", v.seeds);
-    op.get("line_length_m", v.print.line_length_m);
-    op.get("line_start_m", v.print.line_start_m);
-    op.get("extra_time_s", v.print.extra_time_s);
+    get_print(op, v.print);
     op.finish();
-    if (!(v.print.extra_time_s >= 0.0 && v.print.extra_time_s <= 1.0))
-      throw_input("experiment vo-level", "--extra-time", fmt::format("{:g}", v.print.extra_time_s), "out of range", "[0, 1]");
+    check_extra_time("experiment vo-level", v.print);
     j = vo_level(o, v);
   } else if (name == "edge-sharpness") {
     EdgeOptions e;
     op.get("realizations", e.realizations);
-    op.get("line_length_m", e.print.line_length_m);
-    op.get("line_start_m", e.print.line_start_m);
-    op.get("extra_time_s", e.print.extra_time_s);
+    get_print(op, e.print);
     op.get("margin_m", e.margin_m);
     op.get("bootstrap", e.bootstrap);
     op.finish();
-    if (!(e.print.extra_time_s >= 0.0 && e.print.extra_time_s <= 1.0))
-      throw_input("experiment edge-sharpness", "--extra-time", fmt::format("{:g}", e.print.extra_time_s), "out of range", "[0, 1]");
+    check_extra_time("experiment edge-sharpness", e.print);
     j = edge_sharpness(o, e);
   } else {
     throw_input("experiment", "name", name, "unknown experiment", "front-position, reduction, vo-level, edge-sharpness");
