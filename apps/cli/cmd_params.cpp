@@ -14,7 +14,7 @@ struct Opts {
   bool json = false;
 };
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* g = nipdem::cli::group(app, "params", "Derived model parameters");
+  auto* g = nipdem::cli::group(app, "params");
   auto o = std::make_shared<Opts>();
   auto* sub = g->add_subcommand("collision", "Spring-dashpot parameters per collision type (Table 4.2, eqs. 2.2.7, 4.2.25)");
   sub->add_option("--preset", o->preset, "black or color");

@@ -6,7 +6,7 @@
 
 namespace {
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* g = nipdem::cli::group(app, "presets", "CPS700 preset configurations (black, color)");
+  auto* g = nipdem::cli::group(app, "presets");
   g->add_subcommand("list", "List the presets")->callback([] {
     for (const auto& n : nipdem::experiments::preset_names()) std::printf("%s\n", n.c_str());
   });
