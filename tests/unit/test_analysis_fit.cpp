@@ -30,6 +30,14 @@ std::vector<double> grid(double a, double b, double h) {
   return x;
 }
 
+// `n` printed lines of L on x: each point printed (1) with probability L.p(x), else 0.
+std::vector<std::vector<double>> realizations(const TrueLine& L, const std::vector<double>& x, int n, Rng& rng) {
+  std::vector<std::vector<double>> real(n, std::vector<double>(x.size()));
+  for (auto& r : real)
+    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  return real;
+}
+
 }  // namespace
 
 TEST(AnalysisSigmoid, WidthFactorIsTwoLnNine) {
@@ -190,9 +198,7 @@ TEST(AnalysisSigmoid, BootstrapIsReproducibleForASeed) {
   const TrueLine L;
   const auto x = grid(-400e-6, 1000e-6, 4e-6);
   Rng rng(5);
-  std::vector<std::vector<double>> real(20, std::vector<double>(x.size()));
-  for (auto& r : real)
-    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  const std::vector<std::vector<double>> real = realizations(L, x, 20, rng);
   const auto a = bootstrap_line_edges(x, real, 30, 9);
   const auto b = bootstrap_line_edges(x, real, 30, 9);
   EXPECT_EQ(a.front_width_ci.lo, b.front_width_ci.lo);
@@ -218,9 +224,7 @@ TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {
   const TrueLine L;
   const auto x = grid(-400e-6, 1000e-6, 4e-6);
   Rng rng(8);
-  std::vector<std::vector<double>> real(20, std::vector<double>(x.size()));
-  for (auto& r : real)
-    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  const std::vector<std::vector<double>> real = realizations(L, x, 20, rng);
   const auto b = bootstrap_line_edges(x, real, 20, 1);
   const auto j = edge_sharpness_json(b, real.size());
   EXPECT_EQ(j.at("edge_front_m").get<double>(), b.fit.front.width_10_90);
