@@ -3,5 +3,5 @@
 #include "nipdem/nip/nip_config.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  return nipdem::fuzz::run_one(data, size, [](const std::string& text) { nipdem::experiments::parse_nip_config(text, "fuzz.toml"); });
+  return nipdem::fuzz::run_one(data, size, [](const std::string& text) { nipdem::nip::parse_nip_config(text, "fuzz.toml"); });
 }

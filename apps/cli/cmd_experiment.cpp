@@ -17,6 +17,7 @@
 
 namespace {
 using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 struct Common {
   ExperimentOptions o;

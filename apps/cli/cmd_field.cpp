@@ -22,7 +22,7 @@ using namespace nipdem;
 
 // The magnet, toner and radius options of probe and line (nip/presets.hpp), and --json.
 struct Common {
-  experiments::FieldOptions field;
+  nip::FieldOptions field;
   bool json = false;
 };
 
@@ -63,8 +63,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->callback([po] {
     require_range("field probe", "--x", po->x, -1.0, 1.0);
     require_range("field probe", "--y", po->y, -1.0, 1.0);
-    experiments::check_field_options(po->c.field, "field probe");
-    const experiments::FieldSetup s = experiments::make_field_setup(po->c.field);
+    nip::check_field_options(po->c.field, "field probe");
+    const nip::FieldSetup s = nip::make_field_setup(po->c.field);
     const auto smp = s.field->at({po->x, po->y});
     const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
     const Vec2 F = magnet::dipole_force(m, smp);
@@ -120,7 +120,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       throw_input("field export", "--nx, --ny", fmt::format("{} x {}", eo->nx, eo->ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
     if (!(eo->x1 > eo->x0)) throw_input("field export", "--x1", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
     if (!(eo->y1 > eo->y0)) throw_input("field export", "--y1", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
-    const auto f = experiments::preset_magnet(eo->preset);
+    const auto f = nip::preset_magnet(eo->preset);
     io::write_file_atomic(eo->out, io::field_to_csv(f, eo->x0, eo->x1, eo->nx, eo->y0, eo->y1, eo->ny,
                                                     f.describe() + ", magnet frame (see docs/magnetic.md)"));
     std::fprintf(stderr, "wrote %s (%d x %d nodes)\n", eo->out.c_str(), eo->nx, eo->ny);
@@ -140,8 +140,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
     require_range("field line", "--x0", lo->x0, -1.0, 1.0);
     require_range("field line", "--x1", lo->x1, -1.0, 1.0);
     if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
-    experiments::check_field_options(lo->c.field, "field line");
-    const experiments::FieldSetup s = experiments::make_field_setup(lo->c.field);
+    nip::check_field_options(lo->c.field, "field line");
+    const nip::FieldSetup s = nip::make_field_setup(lo->c.field);
     std::vector<std::vector<double>> rows;
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;

@@ -31,7 +31,7 @@ namespace nipdem::python {
 using nlohmann::json;
 
 std::string collision_params(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
-  return experiments::collision_json(experiments::parse_nip_config(text, file, overrides)).dump();
+  return nip::collision_json(nip::parse_nip_config(text, file, overrides)).dump();
 }
 
 ElectricArgs::ElectricArgs()
@@ -109,8 +109,8 @@ std::string force_dipole(const DipoleArgs& a) {
 std::string field_probe(const FieldArgs& f, double x, double y) {
   require_range("field probe", "--x", x, -1.0, 1.0);
   require_range("field probe", "--y", y, -1.0, 1.0);
-  experiments::check_field_options(f, "field probe");
-  const experiments::FieldSetup s = experiments::make_field_setup(f);
+  nip::check_field_options(f, "field probe");
+  const nip::FieldSetup s = nip::make_field_setup(f);
   const auto smp = s.field->at({x, y});
   const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
   const Vec2 F = magnet::dipole_force(m, smp);
@@ -127,7 +127,7 @@ std::string field_export(const FieldArgs& f, double x0, double x1, int nx, doubl
   // the checks of `nipdem field export`, plus those of the probe's magnet options
   require_range("field export", "--nx", nx, 5, 1e5);
   require_range("field export", "--ny", ny, 5, 1e5);
-  experiments::check_field_options(f, "field export");
+  nip::check_field_options(f, "field export");
   if (!f.map.empty()) throw_input("field export", "--map", f.map, "export samples a preset magnet, not a map");
   require_range("field export", "--x0", x0, -1.0, 1.0);
   require_range("field export", "--x1", x1, -1.0, 1.0);
@@ -137,7 +137,7 @@ std::string field_export(const FieldArgs& f, double x0, double x1, int nx, doubl
     throw_input("field export", "--nx, --ny", fmt::format("{} x {}", nx, ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
   if (!(x1 > x0)) throw_input("field export", "--x1", fmt::format("{:g}", x1), "must exceed x0", "> x0");
   if (!(y1 > y0)) throw_input("field export", "--y1", fmt::format("{:g}", y1), "must exceed y0", "> y0");
-  const experiments::FieldSetup s = experiments::make_field_setup(f);
+  const nip::FieldSetup s = nip::make_field_setup(f);
   io::write_file_atomic(out, io::field_to_csv(*s.field, x0, x1, nx, y0, y1, ny, s.field->describe() + ", magnet frame (see docs/magnetic.md)"));
   return json{{"out", out}, {"source", s.field->describe()}, {"nx", nx}, {"ny", ny}}.dump();
 }
@@ -242,6 +242,7 @@ void check_extra_time(const std::string& where, const experiments::PrintOptions&
 
 std::string run_experiment(const std::string& name, const std::string& options) {
   using namespace experiments;
+  using namespace nip;
   Options op(options, "experiment " + name);
   ExperimentOptions o;
   std::string out;

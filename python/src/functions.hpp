@@ -32,7 +32,7 @@ struct DipoleArgs {
 };
 std::string force_dipole(const DipoleArgs& a);  // `nipdem force dipole`
 
-using FieldArgs = experiments::FieldOptions;  // the CLI's options: given or not
+using FieldArgs = nip::FieldOptions;  // the CLI's options: given or not
 std::string field_probe(const FieldArgs& f, double x, double y);  // `nipdem field probe`
 // Samples the magnet of `f` (a preset, or its knife/pole with tip_depth/br changed) on a grid and
 // writes the field-map CSV a config's magnet.map_file reads (atomically). Returns {"out", "source"}.

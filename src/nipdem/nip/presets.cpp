@@ -6,7 +6,7 @@
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/nip/nip_config.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 std::vector<std::string> preset_names() { return {"black", "color"}; }
 std::string preset_text(const std::string& name) {
   if (name == "black") return kPreset_black;
@@ -57,4 +57,4 @@ FieldSetup make_field_setup(const FieldOptions& o) {
   }
   return s;
 }
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

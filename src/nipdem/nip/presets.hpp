@@ -10,7 +10,7 @@
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 std::vector<std::string> preset_names();
 // Complete TOML text of a preset; throws InputError for an unknown name.
 std::string preset_text(const std::string& name);
@@ -52,4 +52,4 @@ struct FieldSetup {
 // The field, toner and radius of `o` (checked with check_field_options first); throws InputError
 // for magnet overrides given with a map, or a map that does not read.
 FieldSetup make_field_setup(const FieldOptions& o);
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip
