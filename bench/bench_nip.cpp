@@ -70,10 +70,10 @@ long maxrss_kb() {
 // Error of the tabulated magnet force: the provider's own table (MagnetForce::field_sample, the
 // 20 um bicubic Hermite tiles with exact cells next to magnet faces) against the exact field at
 // the particle positions. The bound it promises is 2e-3 (docs/magnetic.md "Field tables").
-void report_table_error(const engine::Simulation& sim, const experiments::MagnetConfig& mc) {
-  const auto field = experiments::make_magnet_field(mc);
+void report_table_error(const engine::Simulation& sim, const nip::MagnetConfig& mc) {
+  const auto field = nip::make_magnet_field(mc);
   if (!field) return;
-  experiments::MagnetForce table(field, mc);
+  nip::MagnetForce table(field, mc);
   const auto& b = sim.bodies();
   double max_rel = 0, sum2 = 0, fmax = 0, max_abs = 0;
   for (std::size_t i = 0; i < b.x.size(); ++i) {
@@ -237,17 +237,17 @@ bool load_state(State& s, const std::string& path) {
 // contact times each, so the overlaps shrink quasi-statically to their real size instead of
 // exploding. The knife and the dipole-dipole forces act throughout.
 State make_dense_state(const std::vector<std::string>& base, double press_time, double press_acc, long relax_steps) {
-  auto cfg = experiments::parse_nip_config(experiments::preset_text("black"), "preset:black", base);
+  auto cfg = nip::parse_nip_config(nip::preset_text("black"), "preset:black", base);
   cfg.magnet.threads = cfg.threads;
-  experiments::NipRun nip(cfg);
+  nip::NipRun nip(cfg);
   auto& sim = nip.sim();
   const auto t0 = std::chrono::steady_clock::now();
   const Vec2 g0 = sim.params().gravity;
   auto set_scale = [&](double s) {
     auto c = cfg;
     c.stiffness_scale = s;
-    sim.mutable_params().interactions = experiments::make_interactions(c);
-    sim.mutable_params().dt = experiments::choose_time_step(c).dt;
+    sim.mutable_params().interactions = nip::make_interactions(c);
+    sim.mutable_params().dt = nip::choose_time_step(c).dt;
   };
   auto run_steps = [&](long n) {
     for (long i = 0; i < n; ++i) {
@@ -300,7 +300,7 @@ double g_dipole_skin = -1;  // --dipole-skin: overrides magnet.dipole_skin_m
 
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
   if (start) overrides.push_back("inflow.prefill=false");
-  auto cfg = experiments::parse_nip_config(experiments::preset_text("black"), "preset:black", overrides);
+  auto cfg = nip::parse_nip_config(nip::preset_text("black"), "preset:black", overrides);
   // The magnet's per-particle loop runs on the engine's threads (MagnetConfig::threads is not
   // a config key; the nip should set it from run.threads the same way).
   cfg.magnet.threads = cfg.threads;
@@ -309,20 +309,20 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   // can be timed.
   const auto magnet_cfg = cfg.magnet;
   cfg.magnet.field = "none";
-  experiments::NipRun nip(cfg);
+  nip::NipRun nip(cfg);
   auto& sim = nip.sim();
   std::shared_ptr<TimedForce> timed;
-  std::shared_ptr<experiments::MagnetForce> mf;
-  if (auto field = experiments::make_magnet_field(magnet_cfg)) {
-    mf = std::make_shared<experiments::MagnetForce>(field, magnet_cfg);
+  std::shared_ptr<nip::MagnetForce> mf;
+  if (auto field = nip::make_magnet_field(magnet_cfg)) {
+    mf = std::make_shared<nip::MagnetForce>(field, magnet_cfg);
     timed = std::make_shared<TimedForce>(mf);
     sim.add_force(timed);
   }
   const double dt = nip.time_step().dt;
   if (start) {  // the same bodies in the same order (contact history starts empty)
-    const auto& tmpl = experiments::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
+    const auto& tmpl = nip::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
     for (std::size_t i = 0; i < start->n(); ++i) {
-      engine::BodySpec spec = experiments::make_toner(tmpl, start->size[i], cfg.density);
+      engine::BodySpec spec = nip::make_toner(tmpl, start->size[i], cfg.density);
       spec.position = {start->x[i], start->y[i]};
       spec.angle = start->theta[i];
       spec.velocity = {start->vx[i], start->vy[i]};

@@ -38,8 +38,8 @@ struct Result {
 };
 
 Result run(const std::vector<std::string>& overrides, double x0, double x1, long settle, long steps, bool show) {
-  auto cfg = experiments::parse_nip_config(experiments::preset_text("black"), "preset:black", overrides);
-  experiments::NipRun nip(cfg);
+  auto cfg = nip::parse_nip_config(nip::preset_text("black"), "preset:black", overrides);
+  nip::NipRun nip(cfg);
   const int n = nip.fill_on_roller(x0, x1, 0.0, cfg.gap, 0.6);
   auto& sim = nip.sim();
   const double dt = nip.time_step().dt;

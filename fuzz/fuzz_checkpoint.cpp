@@ -5,14 +5,14 @@
 #include <memory>
 
 #include "fuzz_common.hpp"
-#include "nipdem/experiments/nip.hpp"
-#include "nipdem/experiments/presets.hpp"
+#include "nipdem/nip/nip.hpp"
+#include "nipdem/nip/presets.hpp"
 #include "nipdem/io/checkpoint_file.hpp"
 
 namespace {
-nipdem::experiments::NipRun& target() {
-  static auto run = std::make_unique<nipdem::experiments::NipRun>(nipdem::experiments::parse_nip_config(
-      nipdem::experiments::preset_text("black"), "preset:black",
+nipdem::nip::NipRun& target() {
+  static auto run = std::make_unique<nipdem::nip::NipRun>(nipdem::nip::parse_nip_config(
+      nipdem::nip::preset_text("black"), "preset:black",
       {"geometry.window_x_min_m=-100e-6", "geometry.window_x_max_m=100e-6", "collision.stiffness_scale=0.01", "output.vtk=false",
        "magnet.dipole_dipole=true"}));
   return *run;

@@ -17,6 +17,7 @@
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/models/collision_params.hpp"
+#include "support/engine_fixtures.hpp"
 
 using namespace nipdem;
 using namespace nipdem::engine;
@@ -36,23 +37,12 @@ std::ofstream report(const char* file) {
   return dir ? std::ofstream(std::string(dir) + "/" + file) : std::ofstream();
 }
 
-BodySpec disc(Vec2 pos, Vec2 vel) {
-  BodySpec s;
-  s.offsets = {{0, 0}};
-  s.radii = {kR};
-  s.density = kRho;
-  s.position = pos;
-  s.velocity = vel;
-  return s;
-}
-
-struct Collision { double e, tn; };
+BodySpec disc(Vec2 pos, Vec2 vel) { return test::disc_body(kR, kRho, pos, vel); }
 
 // One collision of a disc with a flat wall (pair = false) or of two equal discs head-on
 // (pair = true), the first contact `phase` (0..1) of a step after t = 0. Returns the measured
-// restitution |v_n after / v_n before| and the contact time (overlap sign changes located by
-// linear interpolation between steps).
-Collision collide(bool pair, double k, double e, double frac, Integrator integ, double phase) {
+// restitution |v_n after / v_n before| and the contact time over its eq. 2.2.7 value.
+test::Collision collide(bool pair, double k, double e, double frac, Integrator integ, double phase) {
   const double m_red = pair ? kMass / 2 : kMass;
   Interaction ia;
   ia.contact.k = k;
@@ -65,15 +55,7 @@ Collision collide(bool pair, double k, double e, double frac, Integrator integ, 
   const double v = 0.003;  // approach speed [m/s] (the nip's relative speeds are ~1e-3-1)
   const double gap = v * p.dt * (phase + 2.0);  // first contact after 2 + phase steps
   std::vector<geometry::Wall> walls;
-  if (!pair) {
-    geometry::Wall w;
-    w.kind = geometry::Wall::Kind::plane;
-    w.name = "plane";
-    w.point = {0, 0};
-    w.normal = {0, 1};
-    w.interaction = 1;
-    walls.push_back(w);
-  }
+  if (!pair) walls.push_back(test::plane_wall({0, 0}, {0, 1}));
   Simulation sim(p, walls);
   if (pair) {
     sim.add_body(disc({0, 0}, {0.5 * v, 0}));
@@ -83,18 +65,9 @@ Collision collide(bool pair, double k, double e, double frac, Integrator integ, 
   }
   auto overlap = [&] { return pair ? 2 * kR - (sim.bodies().x[1] - sim.bodies().x[0]) : kR - sim.bodies().y[0]; };
   auto vn = [&] { return pair ? sim.bodies().vx[1] - sim.bodies().vx[0] : sim.bodies().vy[0]; };
-  const double v0 = vn();
-  double t_in = -1, t_out = -1, prev = overlap(), t_prev = 0;
-  for (int i = 0; i < 100000 && t_out < 0; ++i) {
-    sim.step();
-    const double ov = overlap();
-    if (prev <= 0 && ov > 0) t_in = t_prev + p.dt * (-prev) / (ov - prev);
-    if (prev > 0 && ov <= 0 && t_in >= 0) t_out = t_prev + p.dt * prev / (prev - ov);
-    prev = ov;
-    t_prev = sim.time();
-  }
-  sim.step();  // velocity after the last contact step has been integrated
-  return {std::fabs(vn() / v0), (t_out - t_in) / tn};
+  test::Collision c = test::measure_collision(sim, overlap, vn, p.dt, 100000, 1);
+  c.tn /= tn;
+  return c;
 }
 
 struct Kind { const char* name; bool pair; double k, e; };
@@ -107,7 +80,7 @@ Row sweep_phases(const Kind& c, double frac, Integrator integ, std::ofstream& ph
   Row r{0, 0, 0, 0};
   for (int ph = 0; ph < kPhases; ++ph) {
     const double phase = (ph + 0.5) / kPhases;
-    const Collision col = collide(c.pair, c.k, c.e, frac, integ, phase);
+    const test::Collision col = collide(c.pair, c.k, c.e, frac, integ, phase);
     const double de = (col.e - c.e) / c.e, dt = col.tn - 1.0;
     if (phases) phases << c.name << ',' << name(integ) << ',' << frac << ',' << phase << ',' << de << ',' << dt << '\n';
     r.e_mean_err += de / kPhases;
@@ -177,15 +150,7 @@ Simulation make_box(Integrator integ, double frac, std::uint64_t seed) {
   p.skin = 0.5e-6;
   std::vector<geometry::Wall> walls;
   const std::pair<Vec2, Vec2> planes[] = {{{0, 0}, {0, 1}}, {{0, box}, {0, -1}}, {{0, 0}, {1, 0}}, {{box, 0}, {-1, 0}}};
-  for (const auto& [pt, n] : planes) {
-    geometry::Wall w;
-    w.kind = geometry::Wall::Kind::plane;
-    w.name = "plane";
-    w.point = pt;
-    w.normal = n;
-    w.interaction = 1;
-    walls.push_back(w);
-  }
+  for (const auto& [pt, n] : planes) walls.push_back(test::plane_wall(pt, n));
   Simulation sim(p, walls);
   Rng rng(seed);
   for (int iy = 0; iy < 5; ++iy)

@@ -17,7 +17,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+  auto* cal = nipdem::cli::group(app, "calibrate");
   auto* sub = cal->add_subcommand("adhesion", "Adhesion-force distribution (log-normal) from centrifugal or AFM data (§4.4)");
   auto c = std::make_shared<Opts>();
   sub->add_option("--data", c->data,

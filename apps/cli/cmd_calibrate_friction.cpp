@@ -16,7 +16,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+  auto* cal = nipdem::cli::group(app, "calibrate");
   auto* sub = cal->add_subcommand("friction", "Static and dynamic friction coefficients from a pull record (§4.3.1, eqs. 4.3.1-4.3.3)");
   auto c = std::make_shared<Opts>();
   sub->add_option("--data", c->data, "CSV with columns x_m (increasing), force_N (> 0)")->required();

@@ -16,7 +16,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+  auto* cal = nipdem::cli::group(app, "calibrate");
   auto* sub = cal->add_subcommand("magnetisation", "Ms and saturation flux of the linear-saturated M(H) curve from a VSM record (§4.5)");
   auto c = std::make_shared<Opts>();
   sub->add_option("--data", c->data, "CSV with columns H_A_per_m, M_A_per_m (any order)")->required();

@@ -17,7 +17,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+  auto* cal = nipdem::cli::group(app, "calibrate");
   auto* sub = cal->add_subcommand("restitution", "Normal restitution coefficient from a drop test with Stokes drag (thesis 4.2.1)");
   auto o = std::make_shared<Opts>();
   sub->add_option("--y0", o->p.y0_m, "drop height [m]")->required();

@@ -18,6 +18,7 @@
 
 namespace {
 using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 struct Common {
   ExperimentOptions o;
@@ -58,7 +59,7 @@ void finish(const std::shared_ptr<Common>& c, const std::string& name, const std
 }
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* g = nipdem::cli::group(app, "experiment", "Experiments of thesis chapters 4-5 (ensembles on threads or MPI)");
+  auto* g = nipdem::cli::group(app, "experiment");
   {
     auto c = std::make_shared<Common>();
     auto gaps = std::make_shared<std::string>("150e-6");
@@ -123,7 +124,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
   {
     auto c = std::make_shared<Common>();
     auto k = std::make_shared<nipdem::calibrate::CohesionOptions>();
-    auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+    auto* cal = nipdem::cli::group(app, "calibrate");
     auto* sub = cal->add_subcommand("cohesion", "Fit r = F_coh/F_adh to a measured reduction speed (Table 4.3) over reduction runs (§4.6)");
     add_common(sub, c, "cohesion", /*mpi=*/false);
     sub->add_option("--target-speed", k->target_speed_m_per_s, "measured reduction speed [m/s] (Table 4.3: black 7.6e-4, colour 2.5e-4)")->required();

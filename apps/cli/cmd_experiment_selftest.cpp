@@ -117,7 +117,7 @@ void run_selftest(const Opts& o) {
 }
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* exp = nipdem::cli::group(app, "experiment", "Run experiments of the thesis");
+  auto* exp = nipdem::cli::group(app, "experiment");
   auto* sub = exp->add_subcommand(
       "selftest", "Test harness of the ensemble machinery (threads, MPI, resume) with seeded random walks");
   sub->group("");  // a test harness: hidden from the user's help (it still runs, with its own --help)

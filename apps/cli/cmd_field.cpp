@@ -20,50 +20,18 @@
 namespace {
 using namespace nipdem;
 
+// The magnet, toner and radius options of probe and line (nip/presets.hpp), and --json.
 struct Common {
-  std::string preset = "black";
-  std::string map;
-  std::optional<double> radius;     // default: d50/2 of the preset toner
-  std::optional<double> tip_depth;  // default: the preset magnet's
-  std::optional<double> br;         // default: the preset magnet's
+  nip::FieldOptions field;
   bool json = false;
 };
 
-// Options that were given are checked against their physical range (never ignored, issue 21).
-void check_common(const Common& c, const std::string& where) {
-  if (c.preset != "black" && c.preset != "color") throw_input(where, "--preset", c.preset, "unknown preset", "black, color");
-  if (c.radius) require_range(where, "--radius", *c.radius, 1e-7, 1e-3);
-  if (c.tip_depth) require_range(where, "--tip-depth", *c.tip_depth, 0.0, 5e-3);
-  if (c.br) require_range(where, "--br", *c.br, -2.5, 2.5);
-}
-
-struct Setup {
-  std::unique_ptr<magnet::MagnetField> field;
-  magnet::MagnetisationParams toner;
-  double radius;
-};
-
-Setup make_setup(const Common& c) {
-  Setup s;
-  const experiments::PresetToner t = experiments::preset_toner(c.preset);
-  s.toner = t.magnetisation;
-  s.radius = c.radius.value_or(t.d50_radius_m);
-  require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  if (!c.map.empty()) {
-    if (c.tip_depth || c.br) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
-    s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
-  } else {
-    s.field = std::make_unique<magnet::BlockAssembly>(experiments::preset_magnet(c.preset, {.tip_depth_m = c.tip_depth, .br_T = c.br}));
-  }
-  return s;
-}
-
 void add_common(CLI::App* sub, Common& c) {
-  sub->add_option("--preset", c.preset, "magnet and toner preset: black or color")->capture_default_str();
-  sub->add_option("--map", c.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
-  sub->add_option("--radius", c.radius, "toner radius [m] in [1e-7, 1e-3] (default: d50/2 of the preset toner, Table 2.1)");
-  sub->add_option("--tip-depth", c.tip_depth, "override: depth of the knife edge / pole face below the roller surface [m], in [0, 5e-3]");
-  sub->add_option("--br", c.br, "override: remanence of the knife blade / colour pole [T], in [-2.5, 2.5]");
+  sub->add_option("--preset", c.field.preset, "magnet and toner preset: black or color")->capture_default_str();
+  sub->add_option("--map", c.field.map, "field map CSV (x_m,y_m,Bx_T,By_T) instead of the preset magnet");
+  sub->add_option("--radius", c.field.radius_m, "toner radius [m] in [1e-7, 1e-3] (default: d50/2 of the preset toner, Table 2.1)");
+  sub->add_option("--tip-depth", c.field.tip_depth_m, "override: depth of the knife edge / pole face below the roller surface [m], in [0, 5e-3]");
+  sub->add_option("--br", c.field.br_T, "override: remanence of the knife blade / colour pole [T], in [-2.5, 2.5]");
   sub->add_flag("--json", c.json, "print one JSON object on stdout");
 }
 
@@ -85,7 +53,7 @@ struct LineOpts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* field = nipdem::cli::group(app, "field", "Magnet field of the imaging roller and the force on toner");
+  auto* field = nipdem::cli::group(app, "field");
 
   auto* probe = field->add_subcommand("probe", "B, grad B and the magnet force on a toner particle at one point");
   auto po = std::make_shared<ProbeOpts>();
@@ -95,13 +63,13 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->callback([po] {
     require_range("field probe", "--x", po->x, -1.0, 1.0);
     require_range("field probe", "--y", po->y, -1.0, 1.0);
-    check_common(po->c, "field probe");
-    const Setup s = make_setup(po->c);
+    nip::check_field_options(po->c.field, "field probe");
+    const nip::FieldSetup s = nip::make_field_setup(po->c.field);
     const auto smp = s.field->at({po->x, po->y});
-    const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+    const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
     const Vec2 F = magnet::dipole_force(m, smp);
     if (po->c.json) {
-      nlohmann::json j{{"preset", po->c.preset},
+      nlohmann::json j{{"preset", po->c.field.preset},
                        {"source", s.field->describe()},
                        {"x_m", po->x},
                        {"y_m", po->y},
@@ -112,7 +80,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
                        {"dBx_dy_T_per_m", smp.dB.xy},
                        {"dBy_dx_T_per_m", smp.dB.yx},
                        {"dBy_dy_T_per_m", smp.dB.yy},
-                       {"radius_m", s.radius},
+                       {"radius_m", s.radius_m},
                        {"mx_Am2", m.x},
                        {"my_Am2", m.y},
                        {"moment_Am2", norm(m)},
@@ -125,7 +93,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       std::printf("  point          (%g, %g) m\n", po->x, po->y);
       std::printf("  B              (%.6g, %.6g) T, |B| = %.6g T\n", smp.B.x, smp.B.y, norm(smp.B));
       std::printf("  grad B         [[%.6g, %.6g], [%.6g, %.6g]] T/m\n", smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy);
-      std::printf("  toner R        %g m, moment (%.4g, %.4g) A m^2\n", s.radius, m.x, m.y);
+      std::printf("  toner R        %g m, moment (%.4g, %.4g) A m^2\n", s.radius_m, m.x, m.y);
       std::printf("  magnet force   (%.6g, %.6g) N, |F| = %.6g N\n", F.x, F.y, norm(F));
     }
   });
@@ -152,7 +120,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
       throw_input("field export", "--nx, --ny", fmt::format("{} x {}", eo->nx, eo->ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
     if (!(eo->x1 > eo->x0)) throw_input("field export", "--x1", fmt::format("{:g}", eo->x1), "must exceed x0", "> x0");
     if (!(eo->y1 > eo->y0)) throw_input("field export", "--y1", fmt::format("{:g}", eo->y1), "must exceed y0", "> y0");
-    const auto f = experiments::preset_magnet(eo->preset);
+    const auto f = nip::preset_magnet(eo->preset);
     io::write_file_atomic(eo->out, io::field_to_csv(f, eo->x0, eo->x1, eo->nx, eo->y0, eo->y1, eo->ny,
                                                     f.describe() + ", magnet frame (see docs/magnetic.md)"));
     std::fprintf(stderr, "wrote %s (%d x %d nodes)\n", eo->out.c_str(), eo->nx, eo->ny);
@@ -172,8 +140,8 @@ nipdem::cli::Register reg([](CLI::App& app) {
     require_range("field line", "--x0", lo->x0, -1.0, 1.0);
     require_range("field line", "--x1", lo->x1, -1.0, 1.0);
     if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
-    check_common(lo->c, "field line");
-    const Setup s = make_setup(lo->c);
+    nip::check_field_options(lo->c.field, "field line");
+    const nip::FieldSetup s = nip::make_field_setup(lo->c.field);
     std::vector<std::vector<double>> rows;
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;
@@ -184,7 +152,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     for (int i = 0; i < lo->n; ++i) {
       const double x = lo->x0 + (lo->x1 - lo->x0) * i / (lo->n - 1);
       const auto smp = s.field->at({x, lo->y});
-      const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+      const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
       const Vec2 F = magnet::dipole_force(m, smp);
       rows.push_back({x, lo->y, smp.B.x, smp.B.y, norm(smp.B), smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy, m.x, m.y, F.x, F.y, norm(F)});
       if (i > 0 && (prev_fx > 0) != (F.x > 0))  // linear interpolation of the sign change of F_x
@@ -200,13 +168,13 @@ nipdem::cli::Register reg([](CLI::App& app) {
     const std::vector<std::string> columns = {"x_m", "y_m", "Bx_T", "By_T", "B_T", "dBx_dx_T_per_m", "dBx_dy_T_per_m", "dBy_dx_T_per_m",
                                               "dBy_dy_T_per_m", "mx_Am2", "my_Am2", "Fx_N", "Fy_N", "F_N"};
     io::write_file_atomic(lo->out, fmt::format("# {}; toner preset {}, R = {:g} m; force F = (m.grad)B, m = m(B) of eq. 4.5.1\n",
-                                               s.field->describe(), lo->c.preset, s.radius) +
+                                               s.field->describe(), lo->c.field.preset, s.radius_m) +
                                        io::format_csv(columns, rows, std::vector<std::string>(columns.size(), "{:.9g}")));
     // The picture of the same data (thesis fig. 2.12 analogue), next to the CSV.
     std::filesystem::path png = lo->out;
     png.replace_extension(".png");
     io::PlotSpec plot;
-    plot.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius * 1e6, lo->y * 1e6);
+    plot.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius_m * 1e6, lo->y * 1e6);
     plot.x_label = "x [um] (magnet edge = 0)";
     plot.y_label = "force [nN], |B| [T/100]";
     plot.series = {sb, sfx, sfy};

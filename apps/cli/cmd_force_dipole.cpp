@@ -20,7 +20,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* force = nipdem::cli::group(app, "force", "Evaluate single force laws");
+  auto* force = nipdem::cli::group(app, "force");
   auto* sub = force->add_subcommand(
       "dipole", "Dipole-dipole force between two magnetised toner spheres (thesis 2.4.2, figs 2.14-2.15)");
   auto o = std::make_shared<Opts>();

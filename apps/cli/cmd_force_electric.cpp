@@ -23,7 +23,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* grp = nipdem::cli::group(app, "force", "Evaluate single force laws");
+  auto* grp = nipdem::cli::group(app, "force");
   auto* sub = grp->add_subcommand("electric", "Force on a grounded conducting sphere at a gap from a plate on voltage V");
   auto o = std::make_shared<Opts>();
   sub->add_option("--radius", o->radius, "sphere radius [m]")->required();

@@ -17,7 +17,7 @@ struct Opts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* g = nipdem::cli::group(app, "experiment", "Experiments of thesis chapters 4-5 (ensembles on threads or MPI)");
+  auto* g = nipdem::cli::group(app, "experiment");
   auto* sub = g->add_subcommand("front-force", "Net y-force on a d95/2 front particle vs x and drum distance l (§2.5.4, figs. 2.24-2.25)");
   auto c = std::make_shared<Opts>();
   sub->add_option("--preset", c->e.preset, "black or color")->capture_default_str();

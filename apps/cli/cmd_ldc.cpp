@@ -87,7 +87,7 @@ void run_solve(const std::string& path, bool as_json) {
 }
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* ldc = nipdem::cli::group(app, "ldc", "Local defect correction electrostatic solver (thesis ch. 3)");
+  auto* ldc = nipdem::cli::group(app, "ldc");
   auto* ver = ldc->add_subcommand("verify", "Rerun the verification problems of thesis 3.8-3.10");
   auto vjson = std::make_shared<bool>(false);
   ver->add_flag("--json", *vjson, "print one JSON object");

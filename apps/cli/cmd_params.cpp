@@ -14,7 +14,7 @@ struct Opts {
   bool json = false;
 };
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* g = nipdem::cli::group(app, "params", "Derived model parameters");
+  auto* g = nipdem::cli::group(app, "params");
   auto o = std::make_shared<Opts>();
   auto* sub = g->add_subcommand("collision", "Spring-dashpot parameters per collision type (Table 4.2, eqs. 2.2.7, 4.2.25)");
   sub->add_option("--preset", o->preset, "black or color");
@@ -22,7 +22,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--set", o->sets, "override a config key (repeatable)");
   sub->add_flag("--json", o->json, "print one JSON object");
   sub->callback([o] {
-    using namespace nipdem::experiments;
+    using namespace nipdem::nip;
     if (o->preset.empty() == o->config.empty()) throw nipdem::InputError("params collision: give exactly one of --preset NAME or --config FILE");
     const NipConfig cfg = o->config.empty() ? parse_nip_config(preset_text(o->preset), "preset:" + o->preset, o->sets)
                                             : load_nip_config(o->config, o->sets);

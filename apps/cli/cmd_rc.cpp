@@ -39,7 +39,7 @@ struct CalOpts {
 };
 
 nipdem::cli::Register reg([](CLI::App& app) {
-  auto* rc = nipdem::cli::group(app, "rc", "Probe-circuit (charge model) tools, thesis §4.7");
+  auto* rc = nipdem::cli::group(app, "rc");
   auto* sub = rc->add_subcommand("response", "Amplitude and phase of the probe voltage vs frequency (eqs. 4.7.6-4.7.7)");
   auto o = std::make_shared<ResponseOpts>();
   sub->add_option("--R", o->p.R_ohm, "toner-assembly resistance R [ohm]")->required();
@@ -137,7 +137,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     }
   });
 
-  auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from measurements");
+  auto* cal = nipdem::cli::group(app, "calibrate");
   auto* csub = cal->add_subcommand("rc", "Fit R, Rd, C of the probe circuit to amplitude/phase vs frequency (§4.7)");
   auto c = std::make_shared<CalOpts>();
   csub->add_option("--data", c->data, "CSV with columns frequency_Hz,amplitude_V,phase_deg")->required();

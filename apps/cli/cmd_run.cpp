@@ -21,9 +21,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print summary.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress on stderr");
   sub->callback([o] {
-    const auto cfg = nipdem::experiments::load_nip_config(o->config, o->sets);
-    nipdem::experiments::RunOptions ro{o->resume, o->force, !o->quiet};
-    const auto summary = nipdem::experiments::run_nip(cfg, o->out, ro);
+    const auto cfg = nipdem::nip::load_nip_config(o->config, o->sets);
+    nipdem::nip::RunOptions ro{o->resume, o->force, !o->quiet};
+    const auto summary = nipdem::nip::run_nip(cfg, o->out, ro);
     if (o->json) nipdem::cli::print_json(summary.dump());
     else std::fprintf(stderr, "nipdem run: %s  (developed %lld, returned %lld, lost %lld, %.1f s wall)\n", o->out.c_str(),
                       summary["developed"].get<long long>(), summary["returned"].get<long long>(), summary["lost"].get<long long>(),

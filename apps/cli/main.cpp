@@ -4,7 +4,9 @@
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/wait_policy.hpp"
@@ -19,11 +21,25 @@ std::vector<Registrar>& registry() {
   return r;
 }
 
-CLI::App* group(CLI::App& app, const std::string& name, const std::string& description) {
+CLI::App* group(CLI::App& app, const std::string& name) {
+  // Each group's description, once: several files add to "calibrate", "experiment" and "force",
+  // and which file registers first is up to the linker.
+  static const std::map<std::string, std::string> kDescriptions = {
+      {"calibrate", "Calibrate model parameters from experiments"},
+      {"experiment", "Experiments of thesis chapters 4-5 (ensembles on threads or MPI)"},
+      {"field", "Magnet field of the imaging roller and the force on toner"},
+      {"force", "Evaluate single force laws"},
+      {"ldc", "Local defect correction electrostatic solver (thesis ch. 3)"},
+      {"params", "Derived model parameters"},
+      {"presets", "CPS700 preset configurations (black, color)"},
+      {"rc", "Probe-circuit (charge model) tools, thesis §4.7"},
+  };
   for (CLI::App* s : app.get_subcommands([](CLI::App*) { return true; })) {
     if (s->get_name() == name) return s;
   }
-  CLI::App* g = app.add_subcommand(name, description);
+  const auto d = kDescriptions.find(name);
+  if (d == kDescriptions.end()) throw std::logic_error("cli::group: no description for the group \"" + name + "\" (apps/cli/main.cpp)");
+  CLI::App* g = app.add_subcommand(name, d->second);
   g->require_subcommand(1);
   return g;
 }

@@ -2,7 +2,7 @@
 // the CLI11 app, so adding a command never touches main.cpp.
 //
 //   static nipdem::cli::Register reg([](CLI::App& app) {
-//     auto* force = nipdem::cli::group(app, "force", "Evaluate single force laws");
+//     auto* force = nipdem::cli::group(app, "force");
 //     auto* sub = force->add_subcommand("electric", "...");
 //     ...; sub->callback([=] { ... });
 //   });
@@ -25,9 +25,10 @@ struct Register {
   explicit Register(Registrar r) { registry().push_back(std::move(r)); }
 };
 
-// Returns the subcommand `name` of `app`, creating it (with `description`) if absent.
-// Lets several files add children to one group such as "force" or "experiment".
-CLI::App* group(CLI::App& app, const std::string& name, const std::string& description);
+// Returns the subcommand `name` of `app`, creating it (with its description from the table in
+// main.cpp, which a new group has to be entered in) if absent. Lets several files add children
+// to one group such as "force" or "experiment".
+CLI::App* group(CLI::App& app, const std::string& name);
 
 // Prints one JSON document (already serialised) on stdout followed by a newline.
 void print_json(const std::string& json);

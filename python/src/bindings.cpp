@@ -123,8 +123,8 @@ class Busy {
   std::atomic<bool>& flag_;
 };
 
-const char* exit_name(nipdem::experiments::Exit e) {
-  using nipdem::experiments::Exit;
+const char* exit_name(nipdem::nip::Exit e) {
+  using nipdem::nip::Exit;
   return e == Exit::developed ? "developed" : e == Exit::returned ? "returned" : "lost";
 }
 
@@ -152,12 +152,12 @@ PYBIND11_MODULE(_nipdem, m) {
   });
 
   // ---- configuration
-  m.def("preset_names", &nipdem::experiments::preset_names);
-  m.def("preset_text", &nipdem::experiments::preset_text, py::arg("name"));
+  m.def("preset_names", &nipdem::nip::preset_names);
+  m.def("preset_text", &nipdem::nip::preset_text, py::arg("name"));
   m.def(
       "resolve_config",
       [](const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
-        const auto c = nipdem::experiments::parse_nip_config(text, file, overrides);
+        const auto c = nipdem::nip::parse_nip_config(text, file, overrides);
         return py::make_tuple(c.resolved_toml, c.preset);
       },
       py::arg("text"), py::arg("file"), py::arg("overrides"),
@@ -219,7 +219,7 @@ PYBIND11_MODULE(_nipdem, m) {
       .def_property_readonly("inserted_in_roller_pits", [](const Simulation& s) { return Busy::check(s).run().inserted_on_roller(); })
       .def_property_readonly("removed",
                              [](const Simulation& s) {
-                               using nipdem::experiments::Exit;
+                               using nipdem::nip::Exit;
                                py::dict d;
                                for (Exit e : {Exit::developed, Exit::returned, Exit::lost}) d[exit_name(e)] = Busy::check(s).run().removed(e);
                                return d;

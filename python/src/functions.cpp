@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
-#include <memory>
 #include <set>
 #include <stdexcept>
 
@@ -32,7 +31,7 @@ namespace nipdem::python {
 using nlohmann::json;
 
 std::string collision_params(const std::string& text, const std::string& file, const std::vector<std::string>& overrides) {
-  return experiments::collision_json(experiments::parse_nip_config(text, file, overrides)).dump();
+  return nip::collision_json(nip::parse_nip_config(text, file, overrides)).dump();
 }
 
 ElectricArgs::ElectricArgs()
@@ -107,49 +106,18 @@ std::string force_dipole(const DipoleArgs& a) {
   return j.dump();
 }
 
-namespace {
-// apps/cli/cmd_field.cpp's check_common and make_setup: the field of a preset, a map, or the
-// preset's magnet with tip depth / Br changed; the toner and its radius.
-struct Setup {
-  std::unique_ptr<magnet::MagnetField> field;
-  magnet::MagnetisationParams toner;
-  double radius;
-};
-void check_common(const FieldArgs& c, const std::string& where) {
-  if (c.preset != "black" && c.preset != "color") throw_input(where, "--preset", c.preset, "unknown preset", "black, color");
-  if (c.radius) require_range(where, "--radius", *c.radius, 1e-7, 1e-3);
-  if (c.tip_depth) require_range(where, "--tip-depth", *c.tip_depth, 0.0, 5e-3);
-  if (c.br) require_range(where, "--br", *c.br, -2.5, 2.5);
-}
-Setup make_setup(const FieldArgs& c) {
-  // as apps/cli/cmd_field.cpp: the preset layer knows the magnet and the toner
-  Setup s;
-  const experiments::PresetToner t = experiments::preset_toner(c.preset);
-  s.toner = t.magnetisation;
-  s.radius = c.radius.value_or(t.d50_radius_m);
-  require_range("field", "radius_m", s.radius, 1e-7, 1e-3);
-  if (!c.map.empty()) {
-    if (c.tip_depth || c.br) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
-    s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(c.map));
-  } else {
-    s.field = std::make_unique<magnet::BlockAssembly>(experiments::preset_magnet(c.preset, {.tip_depth_m = c.tip_depth, .br_T = c.br}));
-  }
-  return s;
-}
-}  // namespace
-
 std::string field_probe(const FieldArgs& f, double x, double y) {
   require_range("field probe", "--x", x, -1.0, 1.0);
   require_range("field probe", "--y", y, -1.0, 1.0);
-  check_common(f, "field probe");
-  const Setup s = make_setup(f);
+  nip::check_field_options(f, "field probe");
+  const nip::FieldSetup s = nip::make_field_setup(f);
   const auto smp = s.field->at({x, y});
-  const Vec2 m = magnet::induced_moment(s.toner, s.radius, smp.B);
+  const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
   const Vec2 F = magnet::dipole_force(m, smp);
   json j{{"preset", f.preset},         {"source", s.field->describe()}, {"x_m", x},
          {"y_m", y},                   {"Bx_T", smp.B.x},                {"By_T", smp.B.y},
          {"B_T", norm(smp.B)},         {"dBx_dx_T_per_m", smp.dB.xx},    {"dBx_dy_T_per_m", smp.dB.xy},
-         {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius},
+         {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius_m},
          {"mx_Am2", m.x},              {"my_Am2", m.y},                  {"moment_Am2", norm(m)},
          {"Fx_N", F.x},                {"Fy_N", F.y},                    {"force_N", norm(F)}};
   return j.dump();
@@ -159,7 +127,7 @@ std::string field_export(const FieldArgs& f, double x0, double x1, int nx, doubl
   // the checks of `nipdem field export`, plus those of the probe's magnet options
   require_range("field export", "--nx", nx, 5, 1e5);
   require_range("field export", "--ny", ny, 5, 1e5);
-  check_common(f, "field export");
+  nip::check_field_options(f, "field export");
   if (!f.map.empty()) throw_input("field export", "--map", f.map, "export samples a preset magnet, not a map");
   require_range("field export", "--x0", x0, -1.0, 1.0);
   require_range("field export", "--x1", x1, -1.0, 1.0);
@@ -169,7 +137,7 @@ std::string field_export(const FieldArgs& f, double x0, double x1, int nx, doubl
     throw_input("field export", "--nx, --ny", fmt::format("{} x {}", nx, ny), "too many nodes for a map nipdem reads", "nx * ny <= 1e7");
   if (!(x1 > x0)) throw_input("field export", "--x1", fmt::format("{:g}", x1), "must exceed x0", "> x0");
   if (!(y1 > y0)) throw_input("field export", "--y1", fmt::format("{:g}", y1), "must exceed y0", "> y0");
-  const Setup s = make_setup(f);
+  const nip::FieldSetup s = nip::make_field_setup(f);
   io::write_file_atomic(out, io::field_to_csv(*s.field, x0, x1, nx, y0, y1, ny, s.field->describe() + ", magnet frame (see docs/magnetic.md)"));
   return json{{"out", out}, {"source", s.field->describe()}, {"nx", nx}, {"ny", ny}}.dump();
 }
@@ -258,10 +226,23 @@ class Options {
   json j_;
   std::set<std::string> used_;
 };
+
+// The printed line of vo-level and edge-sharpness (experiments/print_line.hpp).
+void get_print(Options& op, experiments::PrintOptions& p) {
+  op.get("line_length_m", p.line_length_m);
+  op.get("line_start_m", p.line_start_m);
+  op.get("extra_time_s", p.extra_time_s);
+}
+// The CLI checks --extra-time while parsing (CLI::Range(0.0, 1.0)); the same range, after finish().
+void check_extra_time(const std::string& where, const experiments::PrintOptions& p) {
+  if (!(p.extra_time_s >= 0.0 && p.extra_time_s <= 1.0))
+    throw_input(where, "--extra-time", fmt::format("{:g}", p.extra_time_s), "out of range", "[0, 1]");
+}
 }  // namespace
 
 std::string run_experiment(const std::string& name, const std::string& options) {
   using namespace experiments;
+  using namespace nip;
   Options op(options, "experiment " + name);
   ExperimentOptions o;
   std::string out;
@@ -299,24 +280,18 @@ std::string run_experiment(const std::string& name, const std::string& options) 
     op.get("v0_V", v.v0_V);
     op.get("v_max_V", v.v_max_V);
     op.get("seeds", v.seeds);
-    op.get("line_length_m", v.print.line_length_m);
-    op.get("line_start_m", v.print.line_start_m);
-    op.get("extra_time_s", v.print.extra_time_s);
+    get_print(op, v.print);
     op.finish();
-    if (!(v.print.extra_time_s >= 0.0 && v.print.extra_time_s <= 1.0))
-      throw_input("experiment vo-level", "--extra-time", fmt::format("{:g}", v.print.extra_time_s), "out of range", "[0, 1]");
+    check_extra_time("experiment vo-level", v.print);
     j = vo_level(o, v);
   } else if (name == "edge-sharpness") {
     EdgeOptions e;
     op.get("realizations", e.realizations);
-    op.get("line_length_m", e.print.line_length_m);
-    op.get("line_start_m", e.print.line_start_m);
-    op.get("extra_time_s", e.print.extra_time_s);
+    get_print(op, e.print);
     op.get("margin_m", e.margin_m);
     op.get("bootstrap", e.bootstrap);
     op.finish();
-    if (!(e.print.extra_time_s >= 0.0 && e.print.extra_time_s <= 1.0))
-      throw_input("experiment edge-sharpness", "--extra-time", fmt::format("{:g}", e.print.extra_time_s), "out of range", "[0, 1]");
+    check_extra_time("experiment edge-sharpness", e.print);
     j = edge_sharpness(o, e);
   } else {
     throw_input("experiment", "name", name, "unknown experiment", "front-position, reduction, vo-level, edge-sharpness");

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "nipdem/nip/presets.hpp"
+
 namespace nipdem::python {
 
 // `nipdem params collision` for the configuration `text` (named `file`) with `overrides`.
@@ -30,10 +32,7 @@ struct DipoleArgs {
 };
 std::string force_dipole(const DipoleArgs& a);  // `nipdem force dipole`
 
-struct FieldArgs {
-  std::string preset = "black", map;
-  std::optional<double> radius, tip_depth, br;  // given or not, as the CLI's options
-};
+using FieldArgs = nip::FieldOptions;  // the CLI's options: given or not
 std::string field_probe(const FieldArgs& f, double x, double y);  // `nipdem field probe`
 // Samples the magnet of `f` (a preset, or its knife/pole with tip_depth/br changed) on a grid and
 // writes the field-map CSV a config's magnet.map_file reads (atomically). Returns {"out", "source"}.

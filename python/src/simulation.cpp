@@ -6,10 +6,10 @@
 
 namespace nipdem::python {
 
-using experiments::NipRun;
+using nip::NipRun;
 
 Simulation::Simulation(const std::string& text, const std::string& file, const std::vector<std::string>& overrides)
-    : cfg_(experiments::parse_nip_config(text, file, overrides)), run_(std::make_unique<NipRun>(cfg_)) {
+    : cfg_(nip::parse_nip_config(text, file, overrides)), run_(std::make_unique<NipRun>(cfg_)) {
   run_->sim().compute_forces();  // as run_nip before its first snapshot
 }
 

@@ -45,15 +45,15 @@ class Simulation {
   // Set while a call runs with the GIL released (python/src/bindings.cpp).
   std::atomic<bool>& busy() const { return busy_; }
 
-  experiments::NipRun& run() { return *run_; }
-  const experiments::NipRun& run() const { return *run_; }
+  nip::NipRun& run() { return *run_; }
+  const nip::NipRun& run() const { return *run_; }
 
  private:
   // `n` steps that do not cross a multiple of the insert interval, then the pass if one is due.
   void chunk(std::int64_t n);
 
-  experiments::NipConfig cfg_;
-  std::unique_ptr<experiments::NipRun> run_;
+  nip::NipConfig cfg_;
+  std::unique_ptr<nip::NipRun> run_;
   // Body ids at the last force evaluation, if an inflow/outflow pass came after it.
   std::vector<std::int64_t> eval_ids_;
   bool eval_ids_valid_ = false;

@@ -24,6 +24,7 @@
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
 #include "nipdem/models/dipole.hpp"
+#include "support/engine_fixtures.hpp"
 
 namespace {
 std::atomic<bool> g_fail_in_parallel{false};
@@ -72,21 +73,7 @@ void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::f
 namespace {
 using namespace nipdem;
 
-struct Cloud {
-  std::vector<double> x, y, r;
-  std::vector<int> body;
-};
-Cloud cloud(int n, double box, std::uint64_t seed) {
-  Rng rng(seed);
-  Cloud c;
-  for (int i = 0; i < n; ++i) {
-    c.x.push_back(rng.uniform(0, box));
-    c.y.push_back(rng.uniform(0, box));
-    c.r.push_back(rng.uniform(2e-6, 5e-6));
-    c.body.push_back(i);
-  }
-  return c;
-}
+using test::random_discs;
 
 // The fault itself works: an allocation inside a region fails, one outside does not.
 TEST(FaultAlloc, FailsOnlyInsideParallelRegions) {
@@ -108,7 +95,7 @@ TEST(FaultAlloc, FailsOnlyInsideParallelRegions) {
 }
 
 TEST(FaultAlloc, NeighbourListRowsFailingInsideTheRegionComeOutAsBadAlloc) {
-  const Cloud c = cloud(5000, 500e-6, 3);  // >= 1024 discs per thread: the row search runs on 2 threads
+  const test::DiscCloud c = random_discs(5000, 500e-6, 3);  // >= 1024 discs per thread: the row search runs on 2 threads
   geometry::NeighborListParams p;
   p.threads = 2;
   geometry::NeighborList reference;
@@ -171,7 +158,7 @@ TEST(FaultAlloc, WarmForceEvaluationAllocatesNothingInsideItsRegions) {
 }
 
 TEST(FaultAlloc, DipolePairSumAllocatesNothingInsideItsRegion) {
-  const Cloud c = cloud(3000, 400e-6, 5);
+  const test::DiscCloud c = random_discs(3000, 400e-6, 5);
   std::vector<Vec2> m(c.x.size(), Vec2{1e-13, 2e-13});
   dipole::PairSum ps({42e-6, 2e-6, 2});
   std::vector<double> fx, fy, gx, gy;
@@ -194,7 +181,7 @@ TEST(NeighbourListGuard, NonFiniteOrFlungAwayPositionsAreRefused) {
   for (int threads : {1, 2}) {
     for (double bad : {nan, inf, -inf, 1e300, 1e30}) {
       for (int which : {0, 1700}) {  // the first disc (the bounding box starts from it) or another
-        Cloud c = cloud(3000, 500e-6, 9);
+        test::DiscCloud c = random_discs(3000, 500e-6, 9);
         geometry::NeighborListParams p;
         p.threads = threads;
         geometry::NeighborList list;
@@ -212,7 +199,7 @@ TEST(NeighbourListGuard, NonFiniteOrFlungAwayPositionsAreRefused) {
         EXPECT_EQ(list.builds(), 1);
       }
     }
-    Cloud c = cloud(3000, 500e-6, 9);
+    test::DiscCloud c = random_discs(3000, 500e-6, 9);
     c.x[5] = 1e3;  // 1 km away: 1e8 cells, binnable (the cell count is capped)
     geometry::NeighborListParams p;
     p.threads = threads;

@@ -10,7 +10,7 @@
 #include "nipdem/nip/presets.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 namespace {
 // rms |F(now) - F(then)| / rms |F(now)| over bodies present at both times.

@@ -17,7 +17,7 @@
 #include "nipdem/io/atomic_file.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 namespace fs = std::filesystem;
 
 namespace {

@@ -73,8 +73,8 @@ TEST(ResumeOnDisk, KilledAtManyMomentsThenResumedGivesTheUninterruptedFiles) {
       else if (f != "checkpoint.bin") EXPECT_TRUE(got.at(f) == text) << f << " differs";
     }
     // the final checkpoints: the same physical state
-    nipdem::experiments::NipRun a(nipdem::experiments::load_nip_config(cfg, overrides));
-    nipdem::experiments::NipRun b(nipdem::experiments::load_nip_config(cfg, overrides));
+    nipdem::nip::NipRun a(nipdem::nip::load_nip_config(cfg, overrides));
+    nipdem::nip::NipRun b(nipdem::nip::load_nip_config(cfg, overrides));
     a.restore(want.at("checkpoint.bin"), "ref");
     b.restore(got.at("checkpoint.bin"), "resumed");
     EXPECT_EQ(a.sim().time(), b.sim().time());

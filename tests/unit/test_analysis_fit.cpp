@@ -30,6 +30,22 @@ std::vector<double> grid(double a, double b, double h) {
   return x;
 }
 
+// 20 printed lines of TrueLine on -400..1000 um (4 um steps): each point printed (1) with
+// probability L.p(x), else 0.
+struct PrintedLines {
+  std::vector<double> x;
+  std::vector<std::vector<double>> real;
+};
+PrintedLines printed_lines(std::uint64_t seed) {
+  const TrueLine L;
+  Rng rng(seed);
+  PrintedLines s{grid(-400e-6, 1000e-6, 4e-6), {}};
+  s.real.assign(20, std::vector<double>(s.x.size()));
+  for (auto& r : s.real)
+    for (std::size_t i = 0; i < s.x.size(); ++i) r[i] = rng.uniform() < L.p(s.x[i]) ? 1.0 : 0.0;
+  return s;
+}
+
 }  // namespace
 
 TEST(AnalysisSigmoid, WidthFactorIsTwoLnNine) {
@@ -187,12 +203,7 @@ TEST(AnalysisSigmoid, BootstrapSpreadMatchesTrueSpreadForShiftedLines) {
 }
 
 TEST(AnalysisSigmoid, BootstrapIsReproducibleForASeed) {
-  const TrueLine L;
-  const auto x = grid(-400e-6, 1000e-6, 4e-6);
-  Rng rng(5);
-  std::vector<std::vector<double>> real(20, std::vector<double>(x.size()));
-  for (auto& r : real)
-    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  const auto [x, real] = printed_lines(5);
   const auto a = bootstrap_line_edges(x, real, 30, 9);
   const auto b = bootstrap_line_edges(x, real, 30, 9);
   EXPECT_EQ(a.front_width_ci.lo, b.front_width_ci.lo);
@@ -215,12 +226,7 @@ TEST(AnalysisSigmoid, BadInputIsAnInputError) {
 
 TEST(AnalysisReport, EdgeSharpnessJsonKeysAndCoverageFile) {
   // CLI.md keys for `experiment edge-sharpness`; values equal the fit's widths.
-  const TrueLine L;
-  const auto x = grid(-400e-6, 1000e-6, 4e-6);
-  Rng rng(8);
-  std::vector<std::vector<double>> real(20, std::vector<double>(x.size()));
-  for (auto& r : real)
-    for (std::size_t i = 0; i < x.size(); ++i) r[i] = rng.uniform() < L.p(x[i]) ? 1.0 : 0.0;
+  const auto [x, real] = printed_lines(8);
   const auto b = bootstrap_line_edges(x, real, 20, 1);
   const auto j = edge_sharpness_json(b, real.size());
   EXPECT_EQ(j.at("edge_front_m").get<double>(), b.fit.front.width_10_90);

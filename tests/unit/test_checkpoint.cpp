@@ -171,20 +171,20 @@ TEST(EngineCheckpoint, EveryInconsistentCountOrIndexIsRefused) {
 
 // ---- the whole run checkpoint ----
 namespace {
-experiments::NipConfig small_config() {
-  return experiments::parse_nip_config(experiments::preset_text("black"), "preset:black",
+nip::NipConfig small_config() {
+  return nip::parse_nip_config(nip::preset_text("black"), "preset:black",
                                        {"geometry.window_x_min_m=-100e-6", "geometry.window_x_max_m=100e-6",
                                         "collision.stiffness_scale=0.01", "output.vtk=false", "magnet.dipole_dipole=true"});
 }
 // Advances to t, then sends body 0 out of the window and runs one inflow/outflow pass: the state
 // then holds a removal event, a renumbered disc set and forces not yet re-evaluated.
-void advance_and_remove(experiments::NipRun& run, double t) {
+void advance_and_remove(nip::NipRun& run, double t) {
   run.advance_to(t);
   run.sim().bodies().x[0] = run.config().x_max + 1e-3;
   run.exchange();
 }
 std::string run_checkpoint(double t) {
-  experiments::NipRun run(small_config());
+  nip::NipRun run(small_config());
   advance_and_remove(run, t);
   EXPECT_GE(run.removals().size(), 1u);
   return run.checkpoint();
@@ -195,7 +195,7 @@ TEST(RunCheckpoint, IdenticalRunsWriteIdenticalBytesAndDamageIsRefusedNamingTheF
   const std::string a = run_checkpoint(4e-6), b = run_checkpoint(4e-6);
   ASSERT_EQ(a.size(), b.size());
   EXPECT_TRUE(a == b) << "two identical runs must write byte-identical checkpoints";
-  experiments::NipRun target(small_config());
+  nip::NipRun target(small_config());
   target.restore(a, "runs/x/checkpoint.bin");  // the undamaged file restores
   auto refused = [&](const std::string& blob, const char* needle) {
     const std::string m = message_of([&] { target.restore(blob, "runs/x/checkpoint.bin"); });
@@ -230,7 +230,7 @@ TEST(RunCheckpoint, HugeCountersAreRefusedWithoutOverflow) {
   const std::size_t removed_at = 10 + 2 * 8 + 4 * 8 + 2 * 8;  // tag, keys, rng, inserted counters
   const std::int64_t huge = std::int64_t{1} << 62;
   for (int k = 0; k < 2; ++k) std::memcpy(payload.data() + removed_at + 8 * k, &huge, 8);
-  experiments::NipRun target(small_config());
+  nip::NipRun target(small_config());
   const std::string m = message_of([&] { target.restore(io::seal_checkpoint(payload), "x"); });
   EXPECT_TRUE(contains(m, "particle counter")) << m;
 }
@@ -240,7 +240,7 @@ TEST(RunCheckpoint, ResealedRandomDamageNeverCrashes) {
   // crafted file would): each load either succeeds with a checked state or throws InputError.
   const std::string a = run_checkpoint(2e-6);
   const std::string payload(io::open_checkpoint(a, "x"));
-  experiments::NipRun target(small_config());
+  nip::NipRun target(small_config());
   Rng rng(77);
   int refused = 0;
   for (int k = 0; k < 300; ++k) {
@@ -260,10 +260,10 @@ TEST(RunCheckpoint, ResealedRandomDamageNeverCrashes) {
 TEST(RunCheckpoint, ResumeRightAfterBodiesWereRemovedIsBitwiseIdentical) {
   // The checkpoint holds the list of the old numbering, the renumbering and "forces not valid":
   // the resumed run re-evaluates forces and carries contact history exactly as the original.
-  experiments::NipRun a(small_config());
+  nip::NipRun a(small_config());
   advance_and_remove(a, 4e-6);
   const std::string blob = a.checkpoint();
-  experiments::NipRun b(small_config());
+  nip::NipRun b(small_config());
   b.restore(blob, "x");
   const double t = 8e-6;
   a.advance_to(t);

@@ -194,15 +194,17 @@ TEST(ConductionPath, Cost10k) {
   double t_inc = 0;
   std::set<std::pair<int, int>> have;
   for (const auto& e : c) have.insert({std::min(e.i, e.j), std::max(e.i, e.j)});
+  // One contact changes: a random one is removed, one between neighbours a, a + 1 added (if new).
+  auto change_contact = [&] {
+    const std::size_t idx = static_cast<std::size_t>(rng.uniform() * c.size());
+    have.erase({std::min(c[idx].i, c[idx].j), std::max(c[idx].i, c[idx].j)});
+    c[idx] = c.back();
+    c.pop_back();
+    const int a = static_cast<int>(rng.uniform() * (n - 1));
+    if (have.insert({a, a + 1}).second) c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
+  };
   for (int k = 0; k < reps; ++k) {
-    for (int m = 0; m < static_cast<int>(c.size()) / 200; ++m) {  // 0.5 % removed, 0.5 % added
-      const std::size_t idx = static_cast<std::size_t>(rng.uniform() * c.size());
-      have.erase({std::min(c[idx].i, c[idx].j), std::max(c[idx].i, c[idx].j)});
-      c[idx] = c.back();
-      c.pop_back();
-      const int a = static_cast<int>(rng.uniform() * (n - 1));
-      if (have.insert({a, a + 1}).second) c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
-    }
+    for (int m = 0; m < static_cast<int>(c.size()) / 200; ++m) change_contact();  // 0.5 % removed, 0.5 % added
     t0 = clk::now();
     cp.update(c, r);
     t_inc += std::chrono::duration<double>(clk::now() - t0).count();
@@ -212,14 +214,7 @@ TEST(ConductionPath, Cost10k) {
   double t_few = 0;
   const int reps_few = 200;
   for (int k = 0; k < reps_few; ++k) {
-    for (int m = 0; m < 5; ++m) {
-      const std::size_t idx = static_cast<std::size_t>(rng.uniform() * c.size());
-      have.erase({std::min(c[idx].i, c[idx].j), std::max(c[idx].i, c[idx].j)});
-      c[idx] = c.back();
-      c.pop_back();
-      const int a = static_cast<int>(rng.uniform() * (n - 1));
-      if (have.insert({a, a + 1}).second) c.push_back({a, a + 1, rng.uniform(0.5, 1.5)});
-    }
+    for (int m = 0; m < 5; ++m) change_contact();
     t0 = clk::now();
     cp.update(c, r);
     t_few += std::chrono::duration<double>(clk::now() - t0).count();

@@ -1,4 +1,4 @@
-// The dipole-dipole pass of the nip (dipole::PairSum, used by experiments::MagnetForce): a
+// The dipole-dipole pass of the nip (dipole::PairSum, used by nip::MagnetForce): a
 // persistent Verlet pair list with a skin, half list with Newton's third law, threaded. It must
 // give the plain cut-off sum F_i = sum_{|r_ij| < r_c} dipole_force(m_i, m_j, r_ij) (eq. 2.4.39)
 // and must not depend on when the list was built (checkpoint/resume stays bitwise).
@@ -139,7 +139,7 @@ TEST(DipolePass, MagnetForceEqualsBruteForceAndResumesBitwise) {
   // re-evaluated every 2 calls, bodies moving. (a) the dipole part equals the O(N^2) cut-off
   // sum of the provider's own moments to 1e-12 (round-off); (b) a provider restored from a
   // checkpoint taken mid-run (its pair list is not saved) continues bitwise identically.
-  using namespace nipdem::experiments;
+  using namespace nipdem::nip;
   const Cloud c = dense_cloud(300e-6, 9);
   BodyStore b;
   for (std::size_t i = 0; i < c.x.size(); ++i) {

@@ -6,6 +6,7 @@
 
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/models/collision_params.hpp"
+#include "support/engine_fixtures.hpp"
 
 using namespace nipdem;
 using namespace nipdem::engine;
@@ -16,8 +17,6 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kR = 5.25e-6, kRho = 1700.0;
 const double kMass = kRho * 4.0 / 3.0 * kPi * kR * kR * kR;
 
-struct Result { double e, tn; };
-
 Interaction make(double k, double e, double m_red) {
   Interaction ia;
   ia.contact.k = k;
@@ -27,32 +26,7 @@ Interaction make(double k, double e, double m_red) {
   return ia;
 }
 
-BodySpec disc(Vec2 pos, Vec2 vel) {
-  BodySpec s;
-  s.offsets = {{0, 0}};
-  s.radii = {kR};
-  s.density = kRho;
-  s.position = pos;
-  s.velocity = vel;
-  return s;
-}
-
-// Runs the collision and measures e = |v_n after / v_n before| and the contact time with the
-// overlap sign changes located by linear interpolation (error O(dt^2)).
-Result run(Simulation& sim, const std::function<double()>& overlap, const std::function<double()>& vn, double dt) {
-  const double v0 = vn();
-  double t_in = -1, t_out = -1, prev = overlap(), t_prev = 0;
-  for (int i = 0; i < 200000 && t_out < 0; ++i) {
-    sim.step();
-    const double ov = overlap();
-    if (prev <= 0 && ov > 0) t_in = t_prev + dt * (-prev) / (ov - prev);
-    if (prev > 0 && ov <= 0 && t_in >= 0) t_out = t_prev + dt * prev / (prev - ov);
-    prev = ov;
-    t_prev = sim.time();
-  }
-  for (int i = 0; i < 10; ++i) sim.step();  // well clear of the contact
-  return {std::fabs(vn() / v0), t_out - t_in};
-}
+BodySpec disc(Vec2 pos, Vec2 vel) { return test::disc_body(kR, kRho, pos, vel); }
 }  // namespace
 
 class CollisionTest : public ::testing::TestWithParam<Integrator> {};
@@ -70,7 +44,7 @@ TEST_P(CollisionTest, DiscDiscMatchesEq227) {
   sim.add_body(disc({2 * kR + 1e-8, 0}, {-0.003, 0}));
   auto ov = [&] { return 2 * kR - (sim.bodies().x[1] - sim.bodies().x[0]); };
   auto vn = [&] { return sim.bodies().vx[1] - sim.bodies().vx[0]; };
-  const Result r = run(sim, ov, vn, p.dt);
+  const test::Collision r = test::measure_collision(sim, ov, vn, p.dt, 200000, 10);
   // 1 % tolerance (the issue's): both schemes are far more accurate at 1000 steps/contact.
   EXPECT_NEAR(r.e, e, 0.01 * e);
   EXPECT_NEAR(r.tn, tn, 0.01 * tn);
@@ -115,7 +89,7 @@ TEST_P(CollisionTest, DiscWallMatchesEq227ForRollerAndDrum) {
       return o;
     };
     auto vn = [&] { return sim.bodies().vy[0]; };
-    const Result r = run(sim, ov, vn, p.dt);
+    const test::Collision r = test::measure_collision(sim, ov, vn, p.dt, 200000, 10);
     EXPECT_NEAR(r.e, c.e, 0.01 * c.e);
     EXPECT_NEAR(r.tn, tn, 0.01 * tn);
   }

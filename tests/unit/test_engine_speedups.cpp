@@ -18,6 +18,7 @@
 #include <string>
 
 #include "../cli_run.hpp"
+#include "support/engine_fixtures.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
@@ -76,21 +77,6 @@ TEST(EngineRotation, FreeSpinMatchesAnalyticAngleWithoutPerStepTrigonometry) {
 }
 
 namespace {
-struct Discs {
-  std::vector<double> x, y, r;
-  std::vector<int> body;
-};
-Discs random_discs(int n, std::uint64_t seed, double box) {
-  Rng rng(seed);
-  Discs d;
-  for (int i = 0; i < n; ++i) {
-    d.x.push_back(rng.uniform(0, box));
-    d.y.push_back(rng.uniform(0, box));
-    d.r.push_back(rng.uniform(2e-6, 5e-6));
-    d.body.push_back(i / 3);  // triples share a body: those pairs are never listed
-  }
-  return d;
-}
 std::set<std::pair<int, int>> listed(const geometry::NeighborList& nl) {
   std::set<std::pair<int, int>> s;
   for (std::size_t i = 0; i < nl.size(); ++i)
@@ -104,7 +90,7 @@ std::set<std::pair<int, int>> listed(const geometry::NeighborList& nl) {
 // periodic or not.
 TEST(NeighborList, ParallelBuildEqualsSerialBuild) {
   for (bool periodic : {false, true}) {
-    const Discs d = random_discs(6000, 5, 600e-6);
+    const test::DiscCloud d = test::random_discs(6000, 600e-6, 5, 3);  // triples share a body: never listed
     geometry::NeighborListParams p;
     p.skin = 1e-6;
     p.extra_range = 0.3e-6;
@@ -132,7 +118,7 @@ TEST(NeighborList, ParallelBuildEqualsSerialBuild) {
 // displacements since the build exceed the skin; at every step every pair within the
 // interaction range (r_i + r_j + extra) must be in the list (brute force over all pairs).
 TEST(NeighborList, TwoLargestDisplacementCriterionNeverMissesAPair) {
-  Discs d = random_discs(400, 9, 150e-6);
+  test::DiscCloud d = test::random_discs(400, 150e-6, 9, 3);
   geometry::NeighborListParams p;
   p.skin = 1e-6;
   p.extra_range = 0.2e-6;
@@ -173,19 +159,8 @@ TEST(WallCandidates, AWallMovedBetweenListBuildsIsFeltAtOnce) {
   p.interactions = {ia, ia};
   p.dt = 1e-9;
   p.skin = 1e-6;
-  geometry::Wall floor;
-  floor.kind = geometry::Wall::Kind::plane;
-  floor.name = "floor";
-  floor.point = {0, 0};
-  floor.normal = {0, 1};
-  floor.interaction = 1;
-  Simulation sim(p, {floor});
-  BodySpec s;
-  s.offsets = {{0, 0}};
-  s.radii = {2e-6};
-  s.density = 1700;
-  s.position = {0, 10e-6};  // 8 um above the floor: no candidate
-  sim.add_body(s);
+  Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+  sim.add_body(test::disc_body(2e-6, 1700, {0, 10e-6}));  // 8 um above the floor: no candidate
   sim.step();
   EXPECT_EQ(sim.contacts(), 0);
   sim.walls()[0].point = {0, 9e-6};  // the floor moves up into the disc (1 um overlap)

@@ -15,7 +15,7 @@
 #include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 namespace {
 

@@ -11,6 +11,7 @@
 
 using namespace nipdem;
 using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 TEST(FrontForce, PartsEqualTheirModels) {
   ExperimentOptions e;  // black preset

@@ -191,7 +191,7 @@ TEST(MagnetField, BlackKnifeForceTurnsAtTheEdgeAndPullsTowardsRoller) {
   // by §2.5.4 (figs 2.23-2.25: the magnet must beat the electric force, ~1-30 nN, for l >= d50).
   const auto knife = make_knife();
   const auto toner = black_toner();
-  const double R = experiments::preset_toner("black").d50_radius_m;
+  const double R = nip::preset_toner("black").d50_radius_m;
   for (double y : {20e-6, 100e-6, 250e-6}) {
     int changes = 0;
     double where = 0, prev = 0;
@@ -216,7 +216,7 @@ TEST(MagnetField, ColorPoleForceChangesDirectionAtMinus150um) {
   // exactly one sign change, within 2 um (grid step + rounding) of -150 um.
   const auto pole = make_color_pole();
   const auto toner = color_toner();
-  const double R = experiments::preset_toner("color").d50_radius_m;
+  const double R = nip::preset_toner("color").d50_radius_m;
   for (double y : {10e-6, 50e-6, 100e-6, 200e-6}) {
     int changes = 0;
     double where = 0, prev = 0;
@@ -253,7 +253,7 @@ TEST(MagnetField, BadBlocksAndKnifeParametersThrowInputError) {
   ColorPoleParams c;
   c.pole_width_m = 0.0;
   EXPECT_THROW(make_color_pole(c), InputError);
-  EXPECT_THROW(experiments::preset_magnet("magenta"), InputError);
+  EXPECT_THROW(nip::preset_magnet("magenta"), InputError);
   try {
     KnifeParams kk;
     kk.blade_Br_T = 5.0;
@@ -268,17 +268,17 @@ TEST(MagnetField, PresetsNameTheirMagnetAndTonerInTheirConfiguration) {
   // knife / pole of the preset's [magnet] field, with the tip depth and remanence replaced only
   // where given; the toner's d50 from [toner] (Table 2.1: 10.5 and 12 um).
   const Vec2 p{50e-6, 80e-6};
-  EXPECT_EQ(experiments::preset_magnet("black").at(p).B.x, make_knife().at(p).B.x);
-  EXPECT_EQ(experiments::preset_magnet("color").at(p).B.y, make_color_pole().at(p).B.y);
+  EXPECT_EQ(nip::preset_magnet("black").at(p).B.x, make_knife().at(p).B.x);
+  EXPECT_EQ(nip::preset_magnet("color").at(p).B.y, make_color_pole().at(p).B.y);
   KnifeParams k;
   k.tip_depth_m = 150e-6;
   k.blade_Br_T = 1.0;
-  EXPECT_EQ(experiments::preset_magnet("black", {.tip_depth_m = 150e-6, .br_T = 1.0}).at(p).B.y, make_knife(k).at(p).B.y);
+  EXPECT_EQ(nip::preset_magnet("black", {.tip_depth_m = 150e-6, .br_T = 1.0}).at(p).B.y, make_knife(k).at(p).B.y);
   ColorPoleParams c;
   c.Br_T = 0.9;
-  EXPECT_EQ(experiments::preset_magnet("color", {.br_T = 0.9}).at(p).B.y, make_color_pole(c).at(p).B.y);
-  EXPECT_DOUBLE_EQ(experiments::preset_toner("black").d50_radius_m, 0.5 * 10.5e-6);
-  EXPECT_DOUBLE_EQ(experiments::preset_toner("color").d50_radius_m, 0.5 * 12e-6);
-  EXPECT_EQ(experiments::preset_toner("black").magnetisation.Ms_A_per_m, black_toner().Ms_A_per_m);
-  EXPECT_EQ(experiments::preset_toner("color").magnetisation.B_sat_T, color_toner().B_sat_T);
+  EXPECT_EQ(nip::preset_magnet("color", {.br_T = 0.9}).at(p).B.y, make_color_pole(c).at(p).B.y);
+  EXPECT_DOUBLE_EQ(nip::preset_toner("black").d50_radius_m, 0.5 * 10.5e-6);
+  EXPECT_DOUBLE_EQ(nip::preset_toner("color").d50_radius_m, 0.5 * 12e-6);
+  EXPECT_EQ(nip::preset_toner("black").magnetisation.Ms_A_per_m, black_toner().Ms_A_per_m);
+  EXPECT_EQ(nip::preset_toner("color").magnetisation.B_sat_T, color_toner().B_sat_T);
 }

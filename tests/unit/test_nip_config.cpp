@@ -20,7 +20,7 @@
 #include "nipdem/models/hamaker.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 namespace fs = std::filesystem;
 
 namespace {

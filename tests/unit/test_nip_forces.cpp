@@ -11,7 +11,7 @@
 #include "nipdem/io/field_map.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 namespace {
 BodyStore bodies(int n, std::uint64_t seed) {

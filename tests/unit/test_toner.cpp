@@ -9,7 +9,7 @@
 #include "nipdem/nip/toner.hpp"
 
 using namespace nipdem;
-using namespace nipdem::experiments;
+using namespace nipdem::nip;
 
 TEST(TonerSizes, NumberDrawnSamplesReproduceTheVolumeDistribution) {
   // Particles are drawn by number; weighting each by its volume must give back the fitted

@@ -75,19 +75,56 @@ double binomial_sqrt_weight(double p, int n_real) {
   return 1.0 / std::sqrt(v);
 }
 
-// Parameter layout shared by both models: core parameters first, then ceiling, then floor.
+// Parameter layout shared by both models: core parameters first, then ceiling, then floor,
+// each either fitted or fixed at the options' value.
 struct Layout {
   int n_core = 2;
   int i_ceil = -1, i_floor = -1;
+  double fixed_ceiling = 1.0, fixed_floor = 0.0;
   int size() const { return n_core + (i_ceil >= 0) + (i_floor >= 0); }
+  double ceiling(const Eigen::VectorXd& p) const { return i_ceil >= 0 ? p[i_ceil] : fixed_ceiling; }
+  double floor(const Eigen::VectorXd& p) const { return i_floor >= 0 ? p[i_floor] : fixed_floor; }
+  // The start vector: `core`, then the start ceiling A0 and floor F0 where they are fitted.
+  Eigen::VectorXd start(const Eigen::VectorXd& core, double A0, double F0) const {
+    Eigen::VectorXd p0(size());
+    p0 << core, Eigen::VectorXd::Zero(size() - n_core);
+    if (i_ceil >= 0) p0[i_ceil] = A0;
+    if (i_floor >= 0) p0[i_floor] = F0;
+    return p0;
+  }
 };
 Layout make_layout(int n_core, const SigmoidOptions& o) {
   Layout l;
   l.n_core = n_core;
+  l.fixed_ceiling = o.ceiling;
+  l.fixed_floor = o.floor;
   int k = n_core;
   if (o.fit_ceiling) l.i_ceil = k++;
   if (o.fit_floor) l.i_floor = k++;
   return l;
+}
+
+// The fit both sigmoid models share. `model(p, sw, r, J)` gives the residuals and Jacobian
+// scaled by sw[i], the square roots of the least-squares weights. With
+// opt.binomial_realizations > 0 the fit is repeated three times with the binomial variance of
+// the fitted profile `profile(p, x)` (in [0, 1]) as weights; the rss reported is unweighted.
+template <class Model, class Profile>
+LmResult fit_reweighted(const Model& model, const Profile& profile, const Prepared& P, const Eigen::VectorXd& p0,
+                        const SigmoidOptions& opt) {
+  const std::size_t n = P.x.size();
+  std::vector<double> sw(n, 1.0);
+  auto weighted = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) { model(p, sw, r, J); };
+  LmResult R = levenberg_marquardt(weighted, p0, n, opt.max_iterations);
+  for (int pass = 0; pass < (opt.binomial_realizations > 0 ? 3 : 0); ++pass) {
+    for (std::size_t i = 0; i < n; ++i) sw[i] = binomial_sqrt_weight(profile(R.p, P.x[i]), opt.binomial_realizations);
+    R = levenberg_marquardt(weighted, R.p, n, opt.max_iterations);
+  }
+  for (std::size_t i = 0; i < n; ++i) sw[i] = 1.0;  // report the unweighted rms residual
+  Eigen::VectorXd r(n);
+  Eigen::MatrixXd J(n, R.p.size());
+  weighted(R.p, r, J);
+  R.rss = r.squaredNorm();
+  return R;
 }
 
 EdgeFit make_edge(double x0, double w, double floor, double ceiling, double var_w, double var_x0) {
@@ -207,14 +244,8 @@ EdgeFit fit_edge(const std::vector<double>& x_in, const std::vector<double>& c_i
   w = rising ? std::abs(w) : -std::abs(w);
 
   const Layout L = make_layout(2, opt);
-  Eigen::VectorXd p0(L.size());
-  p0 << x0, w, Eigen::VectorXd::Zero(L.size() - 2);
-  if (L.i_ceil >= 0) p0[L.i_ceil] = A0;
-  if (L.i_floor >= 0) p0[L.i_floor] = F0;
-  std::vector<double> sw(n, 1.0);  // sqrt of the least-squares weights
-  auto model = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
-    const double A = L.i_ceil >= 0 ? p[L.i_ceil] : opt.ceiling;
-    const double F = L.i_floor >= 0 ? p[L.i_floor] : opt.floor;
+  auto model = [&](const Eigen::VectorXd& p, const std::vector<double>& sw, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
+    const double A = L.ceiling(p), F = L.floor(p);
     for (std::size_t i = 0; i < n; ++i) {
       const double u = (P.x[i] - p[0]) / p[1];
       const double s = logistic(u), ds = s * (1 - s);
@@ -225,21 +256,9 @@ EdgeFit fit_edge(const std::vector<double>& x_in, const std::vector<double>& c_i
       if (L.i_floor >= 0) J(i, L.i_floor) = sw[i] * (1 - s);
     }
   };
-  LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
-  for (int pass = 0; pass < (opt.binomial_realizations > 0 ? 3 : 0); ++pass) {
-    for (std::size_t i = 0; i < n; ++i)
-      sw[i] = binomial_sqrt_weight(logistic((P.x[i] - R.p[0]) / R.p[1]), opt.binomial_realizations);
-    R = levenberg_marquardt(model, R.p, n, opt.max_iterations);
-  }
-  for (std::size_t i = 0; i < n; ++i) sw[i] = 1.0;  // report the unweighted rms residual
-  {
-    Eigen::VectorXd r(n);
-    Eigen::MatrixXd J(n, R.p.size());
-    model(R.p, r, J);
-    R.rss = r.squaredNorm();
-  }
-  EdgeFit e = make_edge(R.p[0], R.p[1], L.i_floor >= 0 ? R.p[L.i_floor] : opt.floor,
-                        L.i_ceil >= 0 ? R.p[L.i_ceil] : opt.ceiling, R.covariance(1, 1), R.covariance(0, 0));
+  auto profile = [](const Eigen::VectorXd& p, double x) { return logistic((x - p[0]) / p[1]); };
+  const LmResult R = fit_reweighted(model, profile, P, L.start(Eigen::Vector2d(x0, w), A0, F0), opt);
+  EdgeFit e = make_edge(R.p[0], R.p[1], L.floor(R.p), L.ceiling(R.p), R.covariance(1, 1), R.covariance(0, 0));
   e.rms_residual = std::sqrt(R.rss / n);
   e.iterations = R.iterations;
   e.converged = R.converged && std::isfinite(e.w) && e.w != 0.0;
@@ -273,14 +292,8 @@ LineEdgesFit fit_line_edges(const std::vector<double>& x_in, const std::vector<d
   if (!(wf > 1e-6 * span)) wf = wdef;
 
   const Layout L = make_layout(4, opt);
-  Eigen::VectorXd p0(L.size());
-  p0.head(4) << xr, wr, xf, wf;
-  if (L.i_ceil >= 0) p0[L.i_ceil] = A0;
-  if (L.i_floor >= 0) p0[L.i_floor] = F0;
-  std::vector<double> sw(n, 1.0);  // sqrt of the least-squares weights
-  auto model = [&](const Eigen::VectorXd& p, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
-    const double A = L.i_ceil >= 0 ? p[L.i_ceil] : opt.ceiling;
-    const double F = L.i_floor >= 0 ? p[L.i_floor] : opt.floor;
+  auto model = [&](const Eigen::VectorXd& p, const std::vector<double>& sw, Eigen::VectorXd& r, Eigen::MatrixXd& J) {
+    const double A = L.ceiling(p), F = L.floor(p);
     for (std::size_t i = 0; i < n; ++i) {
       const double u = (P.x[i] - p[0]) / p[1];
       const double v = -(P.x[i] - p[2]) / p[3];
@@ -296,23 +309,11 @@ LineEdgesFit fit_line_edges(const std::vector<double>& x_in, const std::vector<d
       if (L.i_floor >= 0) J(i, L.i_floor) = sw[i] * (1 - su * sv);
     }
   };
-  LmResult R = levenberg_marquardt(model, p0, n, opt.max_iterations);
-  for (int pass = 0; pass < (opt.binomial_realizations > 0 ? 3 : 0); ++pass) {
-    for (std::size_t i = 0; i < n; ++i)
-      sw[i] = binomial_sqrt_weight(logistic((P.x[i] - R.p[0]) / R.p[1]) * logistic(-(P.x[i] - R.p[2]) / R.p[3]),
-                                   opt.binomial_realizations);
-    R = levenberg_marquardt(model, R.p, n, opt.max_iterations);
-  }
-  for (std::size_t i = 0; i < n; ++i) sw[i] = 1.0;  // report the unweighted rms residual
-  {
-    Eigen::VectorXd r(n);
-    Eigen::MatrixXd J(n, R.p.size());
-    model(R.p, r, J);
-    R.rss = r.squaredNorm();
-  }
+  auto profile = [](const Eigen::VectorXd& p, double x) { return logistic((x - p[0]) / p[1]) * logistic(-(x - p[2]) / p[3]); };
+  const LmResult R = fit_reweighted(model, profile, P, L.start(Eigen::Vector4d(xr, wr, xf, wf), A0, F0), opt);
   LineEdgesFit f;
-  f.floor = L.i_floor >= 0 ? R.p[L.i_floor] : opt.floor;
-  f.ceiling = L.i_ceil >= 0 ? R.p[L.i_ceil] : opt.ceiling;
+  f.floor = L.floor(R.p);
+  f.ceiling = L.ceiling(R.p);
   f.rise = make_edge(R.p[0], R.p[1], f.floor, f.ceiling, R.covariance(1, 1), R.covariance(0, 0));
   f.fall = make_edge(R.p[2], -R.p[3], f.floor, f.ceiling, R.covariance(3, 3), R.covariance(2, 2));
   f.rms_residual = std::sqrt(R.rss / n);

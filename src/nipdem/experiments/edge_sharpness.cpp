@@ -83,8 +83,8 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   check(e);
   // The line is printed at the configuration's print.voltage_V (default 40 V, §5.3).
   reject_fixed_sets(o, "edge-sharpness", print_fixed_keys(e.print, false));
-  const NipConfig base = base_config(o);
-  const NipConfig line = print_config(base, e.print, std::nullopt, std::nullopt);
+  const nip::NipConfig base = base_config(o);
+  const nip::NipConfig line = print_config(base, e.print, std::nullopt, std::nullopt);
   require_range("experiment edge-sharpness", "--margin", e.margin_m, 20e-6, 5e-3);
   const double volts = line.electric.pattern.segments().empty() ? 40.0 : line.electric.pattern.segments()[0].voltage_V;
   auto task = [&](std::size_t, std::uint64_t seed) {

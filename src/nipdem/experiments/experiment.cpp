@@ -15,9 +15,9 @@ namespace nipdem::experiments {
 
 using nlohmann::json;
 
-NipConfig base_config(const ExperimentOptions& o) {
-  if (!o.config.empty()) return read_nip_config(io::read_file(o.config), o.config, o.sets);
-  return read_nip_config(preset_text(o.preset), "preset:" + o.preset, o.sets);
+nip::NipConfig base_config(const ExperimentOptions& o) {
+  if (!o.config.empty()) return nip::read_nip_config(io::read_file(o.config), o.config, o.sets);
+  return nip::read_nip_config(nip::preset_text(o.preset), "preset:" + o.preset, o.sets);
 }
 
 namespace {
@@ -50,7 +50,7 @@ void reject_fixed_sets(const ExperimentOptions& o, const std::string& experiment
   // 4 mm gap, no inflow, no VTK) are replaced without a note.
   if (!note_config) return;
   try {
-    const std::string text = o.config.empty() ? preset_text(o.preset) : io::read_file(o.config);
+    const std::string text = o.config.empty() ? nip::preset_text(o.preset) : io::read_file(o.config);
     const toml::table root = io::parse_toml(text, o.config.empty() ? "preset:" + o.preset : o.config);
     for (const auto& f : fixed) {
       if (varies(f) || f.use_instead.empty()) continue;  // varies per run, or defines the experiment

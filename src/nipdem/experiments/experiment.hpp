@@ -35,7 +35,7 @@ struct ExperimentOptions {
 
 // The base configuration: the preset or the file, with the user's --set; read, not yet
 // validated (a point edits a copy, then validates it).
-NipConfig base_config(const ExperimentOptions& o);
+nip::NipConfig base_config(const ExperimentOptions& o);
 
 // A key the experiment sets itself.
 struct FixedKey {

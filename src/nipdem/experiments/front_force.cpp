@@ -86,7 +86,7 @@ FrontForceModel make_front_force_model(const ExperimentOptions& e, const FrontFo
   m.cfg = base_config(e);
   m.cfg.gap = f.gap_m;
   validate(m.cfg);
-  m.field = make_magnet_field(m.cfg.magnet);
+  m.field = nip::make_magnet_field(m.cfg.magnet);
   m.radius_m = 0.5 * m.cfg.size.d_small;  // R = d95/2 (§2.5.4; Table 2.1 "d95")
   double v = f.voltage_V;
   if (v == 0.0) {

@@ -45,7 +45,7 @@ struct FrontForcePoint {
 
 // One evaluation (exposed for tests). `printed` selects eq. 2.5.31 as printed.
 struct FrontForceModel {
-  NipConfig cfg;
+  nip::NipConfig cfg;
   std::shared_ptr<const magnet::MagnetField> field;
   double radius_m = 0, voltage_V = 0;
   FrontForcePoint at(double x_m, double l_m) const;

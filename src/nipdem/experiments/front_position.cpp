@@ -48,8 +48,8 @@ std::vector<FixedKey> fixed_keys(const Point& p) {
   return k;
 }
 
-NipConfig point_config(const NipConfig& base, const Point& p) {
-  NipConfig c = base;
+nip::NipConfig point_config(const nip::NipConfig& base, const Point& p) {
+  nip::NipConfig c = base;
   c.gap = p.gap_m;
   c.vtk = false;
   if (p.speed_m_per_s >= 0) c.roller_speed = p.speed_m_per_s;
@@ -57,12 +57,12 @@ NipConfig point_config(const NipConfig& base, const Point& p) {
 }
 
 // One point: sample the assembly's extent until the front is steady or max_time.
-json run_point(const ExperimentOptions& o, const FrontPositionOptions& f, const NipConfig& base, std::size_t i, const Point& p,
+json run_point(const ExperimentOptions& o, const FrontPositionOptions& f, const nip::NipConfig& base, std::size_t i, const Point& p,
                std::uint64_t seed) {
-  NipConfig cfg = point_config(base, p);
+  nip::NipConfig cfg = point_config(base, p);
   cfg.seed = run_seed(seed);
   validate(cfg);
-  NipRun run(cfg);
+  nip::NipRun run(cfg);
   std::vector<double> t, front, back;
   std::vector<std::int64_t> cum_in, cum_out;  // particles in / out of the window so far
   analysis::SteadyState st;
@@ -77,7 +77,7 @@ json run_point(const ExperimentOptions& o, const FrontPositionOptions& f, const 
     const auto e = analysis::assembly_extent(run.sim().time(), xs, eo);
     t.push_back(e.t); front.push_back(e.front); back.push_back(e.back);
     cum_in.push_back(run.inserted());
-    cum_out.push_back(run.removed(Exit::developed) + run.removed(Exit::returned) + run.removed(Exit::lost));
+    cum_out.push_back(run.removed(nip::Exit::developed) + run.removed(nip::Exit::returned) + run.removed(nip::Exit::lost));
     if (run.sim().time() >= f.min_time_s && t.size() >= 40 && t.size() % 10 == 0) {
       st = analysis::detect_steady_state(t, front);
       if (st.steady) break;
@@ -151,9 +151,9 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
   check(f);
   const std::vector<Point> points = points_of(f);
   reject_fixed_sets(o, "front-position", fixed_keys(points[0]));
-  const NipConfig base = base_config(o);
+  const nip::NipConfig base = base_config(o);
   for (const auto& p : points) {  // every point's configuration is checked before anything runs
-    NipConfig c = point_config(base, p);
+    nip::NipConfig c = point_config(base, p);
     validate(c);
   }
   const auto sum = ensemble::run([&](std::size_t i, std::uint64_t seed) { return run_point(o, f, base, i, points[i], seed); },

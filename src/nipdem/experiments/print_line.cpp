@@ -24,10 +24,10 @@ std::vector<FixedKey> print_fixed_keys(const PrintOptions& p, bool voltage_fixed
   return k;
 }
 
-NipConfig print_config(const NipConfig& base, const PrintOptions& p, std::optional<double> voltage_V,
+nip::NipConfig print_config(const nip::NipConfig& base, const PrintOptions& p, std::optional<double> voltage_V,
                        std::optional<std::uint64_t> seed) {
-  NipConfig c = base;
-  set_print_line(c, p.line_start_m, p.line_length_m, voltage_V);
+  nip::NipConfig c = base;
+  nip::set_print_line(c, p.line_start_m, p.line_length_m, voltage_V);
   if (seed) {
     c.vtk = false;
     c.seed = run_seed(*seed);
@@ -36,23 +36,23 @@ NipConfig print_config(const NipConfig& base, const PrintOptions& p, std::option
   return c;
 }
 
-PrintRun print_line(const ExperimentOptions& o, const NipConfig& base, const PrintOptions& p, double voltage, std::uint64_t seed,
+PrintRun print_line(const ExperimentOptions& o, const nip::NipConfig& base, const PrintOptions& p, double voltage, std::uint64_t seed,
                     double tail_m, const std::string* prefix) {
-  const NipConfig cfg = print_config(base, p, voltage, seed);
+  const nip::NipConfig cfg = print_config(base, p, voltage, seed);
   // run until the drum up to line end + tail_m has passed the window's downstream edge
   const double v = std::fabs(cfg.drum_speed);
   const double ride = cfg.nip_x - cfg.x_min;  // nip to the window's downstream edge along the drum
   const double t_end = (p.line_start_m + p.line_length_m + tail_m + ride) / v + p.extra_time_s;
-  NipRun run(cfg);
+  nip::NipRun run(cfg);
   if (prefix) run.restore_before_print_switch(*prefix);
   auto progress = run_progress(o, fmt::format("line at {:g} V (seed {}):", voltage, seed % 100000), run.sim().time(), t_end);
   run.advance_to(t_end, [&] { progress.update(run.sim().time(), run.sim().step_count()); });
   const double t = run.sim().time();
-  return {run.removed(Exit::developed), run.coverage(0.25 * cfg.size.d50), t, v * t - ride};
+  return {run.removed(nip::Exit::developed), run.coverage(0.25 * cfg.size.d50), t, v * t - ride};
 }
 
-std::optional<std::string> print_prefix(const ExperimentOptions& o, const NipConfig& base, const PrintOptions& p, std::uint64_t seed) {
-  NipRun run(print_config(base, p, 1.0, seed));
+std::optional<std::string> print_prefix(const ExperimentOptions& o, const nip::NipConfig& base, const PrintOptions& p, std::uint64_t seed) {
+  nip::NipRun run(print_config(base, p, 1.0, seed));
   const double dt = run.time_step().dt;
   const double t_stop = run.first_print_switch_time() - 2.0 * dt;
   if (!(t_stop > run.config().insert_interval * dt) || !std::isfinite(t_stop)) return std::nullopt;

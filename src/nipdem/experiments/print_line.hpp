@@ -28,22 +28,22 @@ std::vector<FixedKey> print_fixed_keys(const PrintOptions& p, bool voltage_fixed
 
 // The configuration of a print run, validated: base with the line on (at `voltage_V` if given,
 // else the configuration's print voltage); with a seed, the run's (engine seed, no VTK).
-NipConfig print_config(const NipConfig& base, const PrintOptions& p, std::optional<double> voltage_V,
+nip::NipConfig print_config(const nip::NipConfig& base, const PrintOptions& p, std::optional<double> voltage_V,
                        std::optional<std::uint64_t> seed);
 
-struct PrintRun { long printed; std::vector<NipRun::CoverageBin> coverage; double time; double s_observed_m; };
+struct PrintRun { long printed; std::vector<nip::NipRun::CoverageBin> coverage; double time; double s_observed_m; };
 
 // Prints one line; runs until the drum up to `tail_m` beyond the line's end has left the window
 // (+ extra_time_s). s_observed_m: the drum coordinate up to which the drum has left the window.
 // `prefix`: a checkpoint from print_prefix() for the same seed, taken before the track switches
 // on; the run starts from it instead of from t = 0 (identical result, less work).
-PrintRun print_line(const ExperimentOptions& o, const NipConfig& base, const PrintOptions& p, double voltage, std::uint64_t seed,
+PrintRun print_line(const ExperimentOptions& o, const nip::NipConfig& base, const PrintOptions& p, double voltage, std::uint64_t seed,
                     double tail_m = 0.0, const std::string* prefix = nullptr);
 
 // The part of a print run before the drum track first switches on: the same for every voltage
 // of one seed (the track is at its off voltage until then), so a Vo-level scan simulates it once.
 // Stops two time steps before the switch; returns the checkpoint there (nothing if the track
 // switches on within the first insert interval: then there is nothing worth sharing).
-std::optional<std::string> print_prefix(const ExperimentOptions& o, const NipConfig& base, const PrintOptions& p, std::uint64_t seed);
+std::optional<std::string> print_prefix(const ExperimentOptions& o, const nip::NipConfig& base, const PrintOptions& p, std::uint64_t seed);
 
 }  // namespace nipdem::experiments

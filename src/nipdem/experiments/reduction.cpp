@@ -39,8 +39,8 @@ std::vector<FixedKey> fixed_keys(const ReductionOptions& r, double ratio) {
   return k;
 }
 
-NipConfig point_config(const NipConfig& base, const ReductionOptions& r, double ratio) {
-  NipConfig c = base;
+nip::NipConfig point_config(const nip::NipConfig& base, const ReductionOptions& r, double ratio) {
+  nip::NipConfig c = base;
   c.cohesion_ratio = ratio;
   c.gap = kNoDrumGap_m;
   c.layer_thickness = 0.0;
@@ -54,11 +54,11 @@ NipConfig point_config(const NipConfig& base, const ReductionOptions& r, double 
 }
 
 // One point: the pile on the roller, observed for time_s.
-json run_point(const ExperimentOptions& o, const ReductionOptions& r, const NipConfig& base, std::size_t i, std::uint64_t seed) {
-  NipConfig cfg = point_config(base, r, r.cohesion_ratios[i]);
+json run_point(const ExperimentOptions& o, const ReductionOptions& r, const nip::NipConfig& base, std::size_t i, std::uint64_t seed) {
+  nip::NipConfig cfg = point_config(base, r, r.cohesion_ratios[i]);
   cfg.seed = run_seed(seed);
   validate(cfg);
-  NipRun run(cfg);
+  nip::NipRun run(cfg);
   const int n0 = run.fill_on_roller(-0.5 * r.pile_width_m, 0.5 * r.pile_width_m, 0.0, r.pile_height_m, r.pile_area_fraction);
   std::vector<analysis::Extent> ext;
   // front: the supply-roller side; the 5 % outermost particles on each side are the stream
@@ -75,10 +75,10 @@ json run_point(const ExperimentOptions& o, const ReductionOptions& r, const NipC
   }
   // removed from the assembly = what left the window minus what the sleeve brought in its
   // filled pits (those pass through; they are not the assembly's loss)
-  const auto out = run.removed(Exit::returned) + run.removed(Exit::developed);
+  const auto out = run.removed(nip::Exit::returned) + run.removed(nip::Exit::developed);
   json res{{"r", r.cohesion_ratios[i]}, {"initial_particles", n0}, {"removed", out - run.inserted_on_roller()},
            {"left_window", out}, {"brought_in_pits", run.inserted_on_roller()},
-           {"lost", run.removed(Exit::lost)}, {"time_s", run.sim().time()}};
+           {"lost", run.removed(nip::Exit::lost)}, {"time_s", run.sim().time()}};
   if (ext.size() >= 3) {
     const auto rs = analysis::reduction_speed(ext);
     res["reduction_speed_m_per_s"] = rs.speed;
@@ -142,9 +142,9 @@ json report(const ExperimentOptions& o, const ReductionOptions& r, const ensembl
 json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   check(r);
   reject_fixed_sets(o, "reduction", fixed_keys(r, r.cohesion_ratios[0]));
-  const NipConfig base = base_config(o);
+  const nip::NipConfig base = base_config(o);
   for (double ratio : r.cohesion_ratios) {  // every point's configuration is checked before anything runs
-    NipConfig c = point_config(base, r, ratio);
+    nip::NipConfig c = point_config(base, r, ratio);
     validate(c);
   }
   const auto sum = ensemble::run([&](std::size_t i, std::uint64_t seed) { return run_point(o, r, base, i, seed); },

@@ -23,7 +23,7 @@ void check(const VoOptions& v) {
 }
 
 // One seed: the part before the line once, then one line per voltage of the search.
-json run_seed_scan(const ExperimentOptions& o, const VoOptions& v, const NipConfig& base, std::uint64_t seed) {
+json run_seed_scan(const ExperimentOptions& o, const VoOptions& v, const nip::NipConfig& base, std::uint64_t seed) {
   const auto prefix = print_prefix(o, base, v.print, seed);
   const auto res = analysis::find_vo_level(
       [&](double V) { return print_line(o, base, v.print, V, seed, 0.0, prefix ? &*prefix : nullptr).printed; }, search_options(v));
@@ -37,7 +37,7 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   check(v);
   // reject a bad configuration or line before any run starts (exit 2, not failed points)
   reject_fixed_sets(o, "vo-level", print_fixed_keys(v.print, true));
-  const NipConfig base = base_config(o);
+  const nip::NipConfig base = base_config(o);
   print_config(base, v.print, 1.0, std::nullopt);
   const auto sum = ensemble::run([&](std::size_t, std::uint64_t seed) { return run_seed_scan(o, v, base, seed); },
                                  ensemble_options(o, static_cast<std::size_t>(v.seeds), "vo_level"));

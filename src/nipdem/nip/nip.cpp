@@ -13,7 +13,7 @@
 #include "nipdem/io/checkpoint_file.hpp"
 #include "nipdem/geometry/walls.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 using constants::pi;
 
@@ -488,4 +488,4 @@ std::vector<NipRun::CoverageBin> NipRun::coverage(double bin) const {
   return out;
 }
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

@@ -22,7 +22,7 @@
 #include "nipdem/nip/nip_config.hpp"
 #include "nipdem/nip/nip_forces.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 enum class Exit { developed = 0, returned = 1, lost = 2 };
 
@@ -128,4 +128,4 @@ class NipRun {
 // the pit depth to the drum): what the magnet field must be valid over (check_field_region).
 ReachableRegion reachable_region(const NipConfig& c);
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

@@ -17,7 +17,7 @@
 #include <algorithm>
 #include <filesystem>
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 using constants::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -622,4 +622,4 @@ void check_resource_bounds(const NipConfig& c, const TimeStep& ts) {
 }
 }  // namespace
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

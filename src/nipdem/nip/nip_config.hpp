@@ -27,7 +27,7 @@
 #include "nipdem/models/collision_params.hpp"
 #include "nipdem/models/hamaker.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 struct CollisionType {
   double restitution{};  // e_n [-] (§4.2.1)
@@ -159,4 +159,4 @@ std::vector<engine::Interaction> make_interactions(const NipConfig& c);
 struct TimeStep { double dt, bound; std::string limiting; };
 TimeStep choose_time_step(const NipConfig& c);
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

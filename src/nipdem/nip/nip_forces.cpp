@@ -15,7 +15,7 @@
 #include "nipdem/models/electric_screening.hpp"
 #include <set>
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 std::shared_ptr<const magnet::MagnetField> make_magnet_field(const MagnetConfig& c) {
   if (c.field == "none") return nullptr;
@@ -362,9 +362,9 @@ void ElectricForce::add(const BodyStore& b, const DiscStore& d, double t, std::s
   }
 }
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 double ReachableRegion::y_low(double x) const {
   const double dx = x - roller_centre.x;
@@ -419,4 +419,4 @@ void check_field_region(const magnet::MagnetField& f, const ReachableRegion& r, 
   }
 }
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

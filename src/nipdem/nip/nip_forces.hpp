@@ -15,7 +15,7 @@
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 struct MagnetConfig {
   std::string field = "knife";     // "knife" (black unit), "color_pole", "map" or "none"
@@ -164,4 +164,4 @@ struct ReachableRegion {
 // toner feels is never the one inside a magnet), or a field map that does not cover it.
 void check_field_region(const magnet::MagnetField& f, const ReachableRegion& r, const std::string& field_name);
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

@@ -3,9 +3,10 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/embedded_preset_black.hpp"
 #include "nipdem/embedded_preset_color.hpp"
+#include "nipdem/io/field_map.hpp"
 #include "nipdem/nip/nip_config.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 std::vector<std::string> preset_names() { return {"black", "color"}; }
 std::string preset_text(const std::string& name) {
   if (name == "black") return kPreset_black;
@@ -34,4 +35,26 @@ PresetToner preset_toner(const std::string& name) {
   const NipConfig c = read_nip_config(preset_text(name), "preset:" + name);
   return {c.magnet.toner, 0.5 * c.size.d50};
 }
-}  // namespace nipdem::experiments
+
+void check_field_options(const FieldOptions& o, const std::string& where) {
+  if (o.preset != "black" && o.preset != "color") throw_input(where, "--preset", o.preset, "unknown preset", "black, color");
+  if (o.radius_m) require_range(where, "--radius", *o.radius_m, 1e-7, 1e-3);
+  if (o.tip_depth_m) require_range(where, "--tip-depth", *o.tip_depth_m, 0.0, 5e-3);
+  if (o.br_T) require_range(where, "--br", *o.br_T, -2.5, 2.5);
+}
+
+FieldSetup make_field_setup(const FieldOptions& o) {
+  FieldSetup s;
+  const PresetToner t = preset_toner(o.preset);
+  s.toner = t.magnetisation;
+  s.radius_m = o.radius_m.value_or(t.d50_radius_m);
+  require_range("field", "radius_m", s.radius_m, 1e-7, 1e-3);
+  if (!o.map.empty()) {
+    if (o.tip_depth_m || o.br_T) throw_input("field", "--tip-depth/--br", "", "magnet parameters do not apply to a field map");
+    s.field = std::make_unique<io::FieldMap>(io::FieldMap::from_file(o.map));
+  } else {
+    s.field = std::make_unique<magnet::BlockAssembly>(preset_magnet(o.preset, {.tip_depth_m = o.tip_depth_m, .br_T = o.br_T}));
+  }
+  return s;
+}
+}  // namespace nipdem::nip

@@ -2,6 +2,7 @@
 // "black" and "color" mean. Everything a preset implies (its magnet, its toner) is read from
 // the preset's configuration, not restated in code.
 #pragma once
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,7 +10,7 @@
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 std::vector<std::string> preset_names();
 // Complete TOML text of a preset; throws InputError for an unknown name.
 std::string preset_text(const std::string& name);
@@ -28,4 +29,27 @@ struct PresetToner {
   double d50_radius_m;
 };
 PresetToner preset_toner(const std::string& name);
-}  // namespace nipdem::experiments
+
+// What the `field` commands (the CLI's and the Python module's) act on: the field of a preset's
+// magnet, with its tip depth / remanence changed where given, or of a field map instead; the
+// preset's toner and its radius.
+struct FieldOptions {
+  std::string preset = "black";
+  std::string map;                       // field-map CSV (x_m,y_m,Bx_T,By_T); empty: the preset magnet
+  std::optional<double> radius_m;        // [m]; default d50/2 of the preset toner
+  std::optional<double> tip_depth_m;     // [m]; default the preset magnet's (not with a map)
+  std::optional<double> br_T;            // [T]; default the preset magnet's (not with a map)
+};
+// Checks the options that were given against their physical range (never ignored, issue 21);
+// messages name `where` and the command-line options (--preset, --radius, --tip-depth, --br).
+void check_field_options(const FieldOptions& o, const std::string& where);
+
+struct FieldSetup {
+  std::unique_ptr<magnet::MagnetField> field;
+  magnet::MagnetisationParams toner;
+  double radius_m;
+};
+// The field, toner and radius of `o` (checked with check_field_options first); throws InputError
+// for magnet overrides given with a map, or a map that does not read.
+FieldSetup make_field_setup(const FieldOptions& o);
+}  // namespace nipdem::nip

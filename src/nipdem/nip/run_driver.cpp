@@ -14,7 +14,7 @@
 #include "nipdem/io/vtk.hpp"
 #include "nipdem/version.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -232,4 +232,4 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
   return summary;
 }
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

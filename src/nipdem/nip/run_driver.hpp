@@ -15,7 +15,7 @@
 
 #include "nipdem/nip/nip.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 struct RunOptions {
   bool resume = false;
@@ -25,4 +25,4 @@ struct RunOptions {
 
 nlohmann::json run_nip(const NipConfig& cfg, const std::filesystem::path& out, const RunOptions& opt);
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

@@ -8,7 +8,7 @@
 #include "nipdem/embedded_clusters.hpp"
 #include "nipdem/io/toml_reader.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 namespace {
 constexpr double kZ95 = 1.6448536269514722;  // standard normal 95 % quantile
@@ -101,4 +101,4 @@ engine::BodySpec make_toner(const ClusterTemplate& t, double d, double density) 
   return b;
 }
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip

@@ -7,7 +7,7 @@
 #include "nipdem/core/vec2.hpp"
 #include "nipdem/engine/simulation.hpp"
 
-namespace nipdem::experiments {
+namespace nipdem::nip {
 
 // Volume size distribution approximated by a normal distribution in the diameter (§4.1),
 // fitted through the table's quantiles: mean = d50, sigma = (d_large - d_small)/(2 z_0.95)
@@ -45,4 +45,4 @@ engine::BodySpec make_toner(const ClusterTemplate& t, double d, double density);
 // The scale factor of that construction: member radius = scale * template radius.
 double template_scale(const ClusterTemplate& t, double d);
 
-}  // namespace nipdem::experiments
+}  // namespace nipdem::nip
