@@ -164,7 +164,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
   {
     auto c = std::make_shared<Common>();
     auto reports = std::make_shared<std::string>();
-    auto* cal = nipdem::cli::group(app, "calibrate", "Calibrate model parameters from experiments");
+    auto* cal = nipdem::cli::group(app, "calibrate");
     auto* sub = cal->add_subcommand("cohesion-joint", "One r for several units: joint chi2 over `calibrate cohesion --from-sweep` reports (§4.6; docs/reduction.md)");
     sub->add_option("REPORTS", *reports, "comma-separated cohesion reports (JSON), one per unit; a unit is named by its file's stem")->required();
     sub->add_option("--out", c->out, "output folder (default runs/cohesion-joint)");
