@@ -21,6 +21,8 @@ using models::ContactParams;
 using models::TangentialState;
 
 namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 // Rotates the unit vector (c, s) = (cos theta, sin theta) by the step's angle d: for the small
 // angles of a DEM step (|d| <= 1e-2 rad) by the Taylor series of cos d and sin d (truncation
 // below 3e-21, i.e. exact in double precision), else by libm; then one Newton step towards
@@ -305,8 +307,8 @@ void Simulation::update_thread_split() {
 
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
 // list and its history), accumulates force and torque about the disc centre into f and the
-// adhesive part into fa (2 per disc). The contact law is models::normal_force and
-// models::tangential_force, inlined.
+// adhesive part into fa (2 per disc). The contact law is models::contact_force, inlined; the
+// kernel supplies the geometry and turns its magnitudes into vectors and torques.
 template <bool kAdhesion, bool kPeriodic>
 void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out) {
   const ContactParams cp = params_.interactions[0].contact;
@@ -348,33 +350,36 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
       const double inv = 1.0 / dist;
       const double nx = dx * inv, ny = dy * inv;  // from j to i
       const double overlap = rsum - dist;
-      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
-      if (overlap > 0.0) {
+      const bool touching = overlap > 0.0;
+      double li = 0.0, lj = 0.0, vn = 0.0, vt = 0.0, mred = 0.0;
+      if (touching) {
         ++nc;
         const PackedVel vj = V[j];
-        const double li = pi.r - 0.5 * overlap, lj = pj.r - 0.5 * overlap;  // centre to contact point
+        li = pi.r - 0.5 * overlap;  // centre to contact point
+        lj = pj.r - 0.5 * overlap;
         // relative velocity of the contact points: v_c + w x (lever), lever -li n on i, +lj n on j
         const double vrx = (vi.vx + vi.w * li * ny) - (vj.vx - vj.w * lj * ny);
         const double vry = (vi.vy - vi.w * li * nx) - (vj.vy + vj.w * lj * nx);
-        const double vn = vrx * nx + vry * ny;
-        const double vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
-        const double mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
-        const double fn = models::normal_force(cp, overlap, vn, mred);
-        TangentialState st{eta[e], sl[e] != 0};
-        const double ft = models::tangential_force(cp, st, vt, fn, dt, mred);
-        eta[e] = st.eta; sl[e] = st.sliding;
-        fnx = fn * nx - ft * ny;
-        fny = fn * ny + ft * nx;
-        ti = -li * ft;
-        tj = -lj * ft;
-      } else if (sl[e] != 0 || eta[e] != 0.0) {
-        eta[e] = 0.0; sl[e] = 0;
+        vn = vrx * nx + vry * ny;
+        vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
+        mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
+      }
+      // History is written where the contact is, or where an opened contact still holds some.
+      const bool had = sl[e] != 0 || eta[e] != 0.0;
+      TangentialState st{eta[e], sl[e] != 0};
+      const models::ContactForce c = models::contact_force<kAdhesion>(cp, hp, pi.r, pj.r, overlap, vn, vt, mred, dt, st);
+      if (touching || had) { eta[e] = st.eta; sl[e] = st.sliding; }
+      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
+      if (touching) {
+        fnx = c.fn * nx - c.ft * ny;
+        fny = c.fn * ny + c.ft * nx;
+        ti = -li * c.ft;
+        tj = -lj * c.ft;
       }
       if constexpr (kAdhesion) {
-        const double fad = models::hamaker_force(hp, pi.r, pj.r, -overlap);
-        fnx -= fad * nx; fny -= fad * ny;
-        faxi -= fad * nx; fayi -= fad * ny;
-        fa[2 * j] += fad * nx; fa[2 * j + 1] += fad * ny;
+        fnx -= c.fa * nx; fny -= c.fa * ny;
+        faxi -= c.fa * nx; fayi -= c.fa * ny;
+        fa[2 * j] += c.fa * nx; fa[2 * j + 1] += c.fa * ny;
       }
       fxi += fnx; fyi += fny; tqi += ti;
       f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += tj;
@@ -517,21 +522,19 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
     const int bi = d_.body[i];
     for (const auto& h : hits) {
       touched = true;
-      double fnx = 0, fny = 0;
-      const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
-      if (h.gap < 0.0) {
+      const double overlap = -h.gap;
+      const bool touching = overlap > 0.0;
+      const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+      double l = 0.0, vn = 0.0, vt = 0.0;
+      TangentialState st{};
+      if (touching) {
         ++nc;
-        const double overlap = -h.gap;
-        const double l = r - 0.5 * overlap;
+        l = r - 0.5 * overlap;  // centre to contact point
         const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
         const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
         const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
-        const double vn = vrx * h.normal.x + vry * h.normal.y;
-        const double vt = -vrx * h.normal.y + vry * h.normal.x;
-        const double m = b_.mass[bi];
-        const double fn = models::normal_force(ia.contact, overlap, vn, m);
-        const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
-        TangentialState st{};
+        vn = vrx * h.normal.x + vry * h.normal.y;
+        vt = -vrx * h.normal.y + vry * h.normal.x;
         for (int q = 0; q < kWallSlots; ++q) {
           if (d_.wall_key[i * kWallSlots + q] == key) {
             st.eta = d_.wall_eta[i * kWallSlots + q];
@@ -539,16 +542,22 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
             break;
           }
         }
-        const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
+      }
+      // A wall has infinite mass and radius: the reduced mass is the body's. Adhesion is always
+      // evaluated (hamaker_force is 0 for A = 0): walls are few, and this keeps the sums as they were.
+      const models::ContactForce cf = models::contact_force<true>(ia.contact, ia.adhesion, r, kInf, overlap, vn, vt,
+                                                                  b_.mass[bi], dt, st);
+      double fnx = 0, fny = 0;
+      if (touching) {
         if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
           new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
         }
-        fnx = fn * h.normal.x - ft * h.normal.y;
-        fny = fn * h.normal.y + ft * h.normal.x;
-        tq += -l * ft;
+        fnx = cf.fn * h.normal.x - cf.ft * h.normal.y;
+        fny = cf.fn * h.normal.y + cf.ft * h.normal.x;
+        tq += -l * cf.ft;
       }
-      fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
-      fax -= fa * h.normal.x; fay -= fa * h.normal.y;
+      fnx -= cf.fa * h.normal.x; fny -= cf.fa * h.normal.y;
+      fax -= cf.fa * h.normal.x; fay -= cf.fa * h.normal.y;
       fx += fnx; fy += fny;
     }
   }
@@ -692,7 +701,7 @@ Energy Simulation::energy() const {
       if (params_.periodic_x) dx -= L * std::nearbyint(dx / L);
       const double dy = d_.y[i] - d_.y[j];
       const double ov = d_.r[i] + d_.r[j] - std::sqrt(dx * dx + dy * dy);
-      if (ov > 0) e.elastic += 0.5 * cp.k * ov * ov + 0.5 * cp.ks * nlist_.eta_[k] * nlist_.eta_[k];
+      e.elastic += models::contact_energy(cp, ov, nlist_.eta_[k]);
     }
   }
   std::vector<geometry::WallHit> hits;
@@ -703,10 +712,11 @@ Energy Simulation::energy() const {
       const auto& wc = params_.interactions[walls_[w].interaction].contact;
       for (auto& h : hits) {
         if (h.gap >= 0) continue;
-        e.elastic += 0.5 * wc.k * h.gap * h.gap;
         const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+        double eta = 0.0;  // a contact beyond the history slots has none
         for (int q = 0; q < kWallSlots; ++q)
-          if (d_.wall_key[i * kWallSlots + q] == key) e.elastic += 0.5 * wc.ks * std::pow(d_.wall_eta[i * kWallSlots + q], 2);
+          if (d_.wall_key[i * kWallSlots + q] == key) eta = d_.wall_eta[i * kWallSlots + q];
+        e.elastic += models::contact_energy(wc, -h.gap, eta);
       }
     }
   }
