@@ -68,48 +68,53 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   nl_params_.x_hi = params_.x_hi;
 }
 
+MassProperties mass_properties(const BodySpec& s) {
+  const std::size_t n = s.offsets.size();
+  MassProperties mp;
+  std::vector<double> mk(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = s.radii[k];
+    mk[k] = s.density * 4.0 / 3.0 * constants::pi * r * r * r;  // each member a solid sphere (§2.1)
+    mp.mass += mk[k];
+    mp.com += mk[k] * s.offsets[k];
+  }
+  mp.com /= mp.mass;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = s.radii[k];
+    const double own = s.sphere_inertia ? 0.4 * mk[k] * r * r : 0.5 * mk[k] * r * r;
+    mp.inertia += own + mk[k] * norm2(s.offsets[k] - mp.com);  // parallel-axis theorem
+  }
+  return mp;
+}
+
 int Simulation::add_body(const BodySpec& s) {
   const std::size_t n = s.offsets.size();
   if (n == 0 || s.radii.size() != n) throw_input("body", "discs", std::to_string(n), "need >= 1 disc with one radius each");
   require_positive("body", "density_kg_per_m3", s.density);
-  double m = 0.0;
-  Vec2 com{};
-  std::vector<double> mk(n);
+  for (const double r : s.radii) require_positive("body", "radius_m", r);
+  const MassProperties mp = mass_properties(s);
+  // Every array grows by one body (its discs), value-initialised (0); then the entries that are
+  // not 0 are set.
+  const std::size_t bi = b_.size_n(), d0 = d_.size_n();
+  b_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize((bi + 1) * per); });
+  d_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize((d0 + n) * per); });
+  b_.x[bi] = s.position.x; b_.y[bi] = s.position.y;
+  b_.vx[bi] = s.velocity.x; b_.vy[bi] = s.velocity.y;
+  b_.theta[bi] = s.angle; b_.omega[bi] = s.omega;
+  b_.cth[bi] = std::cos(s.angle); b_.sth[bi] = std::sin(s.angle);
+  b_.mass[bi] = mp.mass; b_.inertia[bi] = mp.inertia;
+  b_.id[bi] = next_id_++;
+  b_.first_disc[bi] = static_cast<int>(d0);
+  b_.n_discs[bi] = static_cast<int>(n);
+  b_.tag[bi] = s.tag;
+  b_.size[bi] = s.size;
   for (std::size_t k = 0; k < n; ++k) {
-    require_positive("body", "radius_m", s.radii[k]);
-    const double r = s.radii[k];
-    mk[k] = s.density * 4.0 / 3.0 * constants::pi * r * r * r;  // each member a solid sphere (§2.1)
-    m += mk[k];
-    com += mk[k] * s.offsets[k];
-  }
-  com /= m;
-  double inertia = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double r = s.radii[k];
-    const double own = s.sphere_inertia ? 0.4 * mk[k] * r * r : 0.5 * mk[k] * r * r;
-    inertia += own + mk[k] * norm2(s.offsets[k] - com);  // parallel-axis theorem
-  }
-  const int bi = static_cast<int>(b_.x.size());
-  b_.x.push_back(s.position.x); b_.y.push_back(s.position.y);
-  b_.vx.push_back(s.velocity.x); b_.vy.push_back(s.velocity.y);
-  b_.theta.push_back(s.angle); b_.omega.push_back(s.omega);
-  b_.cth.push_back(std::cos(s.angle)); b_.sth.push_back(std::sin(s.angle));
-  b_.fx.push_back(0.0); b_.fy.push_back(0.0); b_.torque.push_back(0.0);
-  b_.mass.push_back(m); b_.inertia.push_back(inertia);
-  b_.id.push_back(next_id_++);
-  b_.first_disc.push_back(static_cast<int>(d_.x.size()));
-  b_.n_discs.push_back(static_cast<int>(n));
-  b_.tag.push_back(s.tag);
-  b_.size.push_back(s.size);
-  for (std::size_t k = 0; k < n; ++k) {
-    const Vec2 o = s.offsets[k] - com;
-    d_.ox.push_back(o.x); d_.oy.push_back(o.y);
-    d_.r.push_back(s.radii[k]);
-    d_.body.push_back(bi);
-    d_.x.push_back(0.0); d_.y.push_back(0.0); d_.wx.push_back(0.0); d_.wy.push_back(0.0);
-    d_.fx.push_back(0.0); d_.fy.push_back(0.0); d_.tq.push_back(0.0);
-    d_.fax.push_back(0.0); d_.fay.push_back(0.0);
-    for (int q = 0; q < kWallSlots; ++q) { d_.wall_key.push_back(-1); d_.wall_eta.push_back(0.0); d_.wall_slide.push_back(0); }
+    const std::size_t i = d0 + k;
+    const Vec2 o = s.offsets[k] - mp.com;
+    d_.ox[i] = o.x; d_.oy[i] = o.y;
+    d_.r[i] = s.radii[k];
+    d_.body[i] = static_cast<int>(bi);
+    for (int q = 0; q < kWallSlots; ++q) d_.wall_key[i * kWallSlots + q] = -1;  // empty history slot
     old_of_new_.push_back(-1);
   }
   update_disc_positions(bi, bi + 1);
@@ -118,7 +123,7 @@ int Simulation::add_body(const BodySpec& s) {
   for (auto& v : prov_tq_) v.push_back(0.0);
   structure_changed_ = true;
   forces_valid_ = false;
-  return bi;
+  return static_cast<int>(bi);
 }
 
 std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
@@ -131,52 +136,32 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   std::size_t bw = 0, dw = 0;
   std::vector<int> new_old_of_new;
   new_old_of_new.reserve(d_.x.size());
-  auto move_body = [&](std::size_t from, std::size_t to) {
-    b_.x[to] = b_.x[from]; b_.y[to] = b_.y[from]; b_.vx[to] = b_.vx[from]; b_.vy[to] = b_.vy[from];
-    b_.theta[to] = b_.theta[from]; b_.omega[to] = b_.omega[from];
-    b_.cth[to] = b_.cth[from]; b_.sth[to] = b_.sth[from];
-    b_.fx[to] = b_.fx[from]; b_.fy[to] = b_.fy[from]; b_.torque[to] = b_.torque[from];
-    b_.mass[to] = b_.mass[from]; b_.inertia[to] = b_.inertia[from]; b_.id[to] = b_.id[from];
-    b_.n_discs[to] = b_.n_discs[from]; b_.tag[to] = b_.tag[from]; b_.size[to] = b_.size[from];
-    for (std::size_t k = 0; k < prov_fx_.size(); ++k) {
-      prov_fx_[k][to] = prov_fx_[k][from]; prov_fy_[k][to] = prov_fy_[k][from]; prov_tq_[k][to] = prov_tq_[k][from];
-    }
-  };
-  auto move_disc = [&](std::size_t from, std::size_t to, int body) {
-    d_.x[to] = d_.x[from]; d_.y[to] = d_.y[from]; d_.ox[to] = d_.ox[from]; d_.oy[to] = d_.oy[from];
-    d_.wx[to] = d_.wx[from]; d_.wy[to] = d_.wy[from];
-    d_.r[to] = d_.r[from]; d_.body[to] = body;
-    d_.fx[to] = d_.fx[from]; d_.fy[to] = d_.fy[from]; d_.tq[to] = d_.tq[from];
-    d_.fax[to] = d_.fax[from]; d_.fay[to] = d_.fay[from];
-    for (int q = 0; q < kWallSlots; ++q) {
-      d_.wall_key[to * kWallSlots + q] = d_.wall_key[from * kWallSlots + q];
-      d_.wall_eta[to * kWallSlots + q] = d_.wall_eta[from * kWallSlots + q];
-      d_.wall_slide[to * kWallSlots + q] = d_.wall_slide[from * kWallSlots + q];
-    }
+  auto move = [](std::size_t from, std::size_t to) {
+    return [=](const char*, auto& v, std::size_t per) {
+      for (std::size_t q = 0; q < per; ++q) v[to * per + q] = v[from * per + q];
+    };
   };
   for (std::size_t i = 0; i < nb; ++i) {
     if (drop[i]) continue;
     const int first = b_.first_disc[i], nd = b_.n_discs[i];
-    move_body(i, bw);
+    b_.for_each_array(move(i, bw));
+    for (std::size_t k = 0; k < prov_fx_.size(); ++k) {
+      prov_fx_[k][bw] = prov_fx_[k][i]; prov_fy_[k][bw] = prov_fy_[k][i]; prov_tq_[k][bw] = prov_tq_[k][i];
+    }
     b_.first_disc[bw] = static_cast<int>(dw);
     for (int k = 0; k < nd; ++k) {
-      move_disc(first + k, dw, static_cast<int>(bw));
+      d_.for_each_array(move(static_cast<std::size_t>(first + k), dw));
+      d_.body[dw] = static_cast<int>(bw);
       new_old_of_new.push_back(old_of_new_[first + k]);
       ++dw;
     }
     ++bw;
   }
-  auto shrink = [](auto& v, std::size_t n) { v.resize(n); };
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
-                  &b_.mass, &b_.inertia, &b_.size}) shrink(*v, bw);
-  shrink(b_.id, bw); shrink(b_.first_disc, bw); shrink(b_.n_discs, bw); shrink(b_.tag, bw);
+  b_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize(bw * per); });
+  d_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize(dw * per); });
   for (auto& v : prov_fx_) v.resize(bw);
   for (auto& v : prov_fy_) v.resize(bw);
   for (auto& v : prov_tq_) v.resize(bw);
-  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
-    shrink(*v, dw);
-  shrink(d_.body, dw);
-  shrink(d_.wall_key, dw * kWallSlots); shrink(d_.wall_eta, dw * kWallSlots); shrink(d_.wall_slide, dw * kWallSlots);
   old_of_new_.swap(new_old_of_new);
   structure_changed_ = true;
   forces_valid_ = false;
