@@ -10,6 +10,7 @@
 #include "nipdem/models/collision_params.hpp"
 #include "nipdem/models/contact.hpp"
 #include "nipdem/models/hamaker.hpp"
+#include "support/engine_fixtures.hpp"
 
 using namespace nipdem;
 using namespace nipdem::models;
@@ -172,24 +173,10 @@ TEST(ContactEvaluator, EnginePairAndWallLoopsApplyTheEvaluator) {
   tw.adhesion.hamaker_J = 2e-19;
   p.interactions = {tt, tw};
   p.dt = kDt;
-  geometry::Wall floor;
-  floor.kind = geometry::Wall::Kind::plane;
-  floor.name = "floor";
-  floor.point = {0, 0};
-  floor.normal = {0, 1};
-  floor.interaction = 1;
-  engine::Simulation sim(p, {floor});
-  auto disc = [](Vec2 pos, double r) {
-    engine::BodySpec s;
-    s.offsets = {{0, 0}};
-    s.radii = {r};
-    s.density = 1700;
-    s.position = pos;
-    return s;
-  };
+  engine::Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
   const double xi_w = 4e-9, xi_p = 6e-9;  // wall overlap of disc 0, pair overlap
-  sim.add_body(disc({0, kR1 - xi_w}, kR1));
-  sim.add_body(disc({0, kR1 - xi_w + kR1 + kR2 - xi_p}, kR2));
+  sim.add_body(test::disc_body(kR1, 1700, {0, kR1 - xi_w}));
+  sim.add_body(test::disc_body(kR2, 1700, {0, kR1 - xi_w + kR1 + kR2 - xi_p}));
   sim.compute_forces();
   EXPECT_EQ(sim.contacts(), 2);
   TangentialState s0{}, s1{};

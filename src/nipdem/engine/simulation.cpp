@@ -68,6 +68,8 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   nl_params_.x_hi = params_.x_hi;
 }
 
+// Expects a spec add_body accepts (as many radii as offsets, at least one; positive density and
+// radii): add_body checks that before calling it.
 MassProperties mass_properties(const BodySpec& s) {
   const std::size_t n = s.offsets.size();
   MassProperties mp;
