@@ -19,10 +19,7 @@ const double kMass = kRho * 4.0 / 3.0 * kPi * kR * kR * kR;
 
 Interaction make(double k, double e, double m_red) {
   Interaction ia;
-  ia.contact.k = k;
-  ia.contact.gamma = gamma_from_restitution(k, m_red, e);
-  ia.contact.ks = 2.0 * k / 7.0;
-  ia.contact.mu_s = 0.5; ia.contact.mu_d = 0.3;
+  ia.contact = contact_params(k, e, m_red, 0.5, 0.3);
   return ia;
 }
 

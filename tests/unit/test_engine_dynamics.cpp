@@ -9,6 +9,7 @@
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/models/collision_params.hpp"
+#include "support/engine_fixtures.hpp"
 
 using namespace nipdem;
 using namespace nipdem::engine;
@@ -28,13 +29,7 @@ struct ConstantForce : BodyForce {
 };
 
 geometry::Wall plane(Vec2 point, Vec2 normal, int interaction = 1, const char* name = "plane") {
-  geometry::Wall w;
-  w.kind = geometry::Wall::Kind::plane;
-  w.name = name;
-  w.point = point;
-  w.normal = normal / norm(normal);
-  w.interaction = interaction;
-  return w;
+  return test::plane_wall(point, normal / norm(normal), interaction, name);
 }
 
 BodySpec single(double r, Vec2 pos, double rho = 1700) {
@@ -130,11 +125,7 @@ TEST(NewmarkStability, StableJustBelowBoundUnstableJustAbove) {
 namespace {
 Interaction friction_ia(double k, double mu_s, double mu_d, double m) {
   Interaction ia;
-  ia.contact.k = k;
-  ia.contact.gamma = gamma_from_restitution(k, m, 0.5);
-  ia.contact.ks = 2.0 * k / 7.0;
-  ia.contact.mu_s = mu_s;
-  ia.contact.mu_d = mu_d;
+  ia.contact = contact_params(k, 0.5, m, mu_s, mu_d);
   return ia;
 }
 

@@ -23,6 +23,21 @@ struct BodyStore {
   std::vector<double> size;              // user size measure (e.g. volume-equivalent diameter) [m]
 
   std::size_t size_n() const { return x.size(); }
+
+  // Calls f(name, array, per) for every per-body array, in checkpoint order (per = entries per
+  // body). The engine adds, removes, saves and loads bodies through this one list, so a new
+  // field is declared here and in the visitor, nowhere else. Changing the order changes the
+  // checkpoint format (engine/checkpoint.cpp's magic).
+  template <class F> void for_each_array(F&& f) { visit(*this, f); }
+  template <class F> void for_each_array(F&& f) const { visit(*this, f); }
+
+ private:
+  template <class S, class F> static void visit(S& s, F& f) {
+    f("x", s.x, 1); f("y", s.y, 1); f("vx", s.vx, 1); f("vy", s.vy, 1); f("theta", s.theta, 1); f("omega", s.omega, 1);
+    f("cos theta", s.cth, 1); f("sin theta", s.sth, 1); f("fx", s.fx, 1); f("fy", s.fy, 1); f("torque", s.torque, 1);
+    f("mass", s.mass, 1); f("inertia", s.inertia, 1); f("size", s.size, 1);
+    f("id", s.id, 1); f("first_disc", s.first_disc, 1); f("n_discs", s.n_discs, 1); f("tag", s.tag, 1);
+  }
 };
 
 // Wall contact history slots per disc: enough for a disc touching a drum, a roller face
@@ -44,6 +59,19 @@ struct DiscStore {
   std::vector<std::uint8_t> wall_slide;  // kWallSlots per disc
 
   std::size_t size_n() const { return x.size(); }
+
+  // Calls f(name, array, per) for every per-disc array, in checkpoint order (per = entries per
+  // disc); as BodyStore::for_each_array.
+  template <class F> void for_each_array(F&& f) { visit(*this, f); }
+  template <class F> void for_each_array(F&& f) const { visit(*this, f); }
+
+ private:
+  template <class S, class F> static void visit(S& s, F& f) {
+    f("x", s.x, 1); f("y", s.y, 1); f("ox", s.ox, 1); f("oy", s.oy, 1); f("wx", s.wx, 1); f("wy", s.wy, 1);
+    f("r", s.r, 1); f("fx", s.fx, 1); f("fy", s.fy, 1); f("tq", s.tq, 1); f("fax", s.fax, 1); f("fay", s.fay, 1);
+    f("body", s.body, 1); f("wall_key", s.wall_key, kWallSlots); f("wall_eta", s.wall_eta, kWallSlots);
+    f("wall_slide", s.wall_slide, kWallSlots);
+  }
 };
 
 }  // namespace nipdem

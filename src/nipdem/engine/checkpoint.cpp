@@ -14,6 +14,7 @@
 #include <istream>
 #include <ostream>
 #include <string>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -53,12 +54,9 @@ void require_flags(const std::vector<std::uint8_t>& v, const char* name) {
 void Simulation::save(std::ostream& o) const {
   put(o, kMagic);
   put(o, time_); put(o, step_); put(o, next_id_);
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
-                  &b_.mass, &b_.inertia, &b_.size}) put_vec(o, *v);
-  put_vec(o, b_.id); put_vec(o, b_.first_disc); put_vec(o, b_.n_discs); put_vec(o, b_.tag);
-  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
-    put_vec(o, *v);
-  put_vec(o, d_.body); put_vec(o, d_.wall_key); put_vec(o, d_.wall_eta); put_vec(o, d_.wall_slide);
+  const auto put_array = [&](const char*, const auto& v, std::size_t) { put_vec(o, v); };
+  b_.for_each_array(put_array);
+  d_.for_each_array(put_array);
   put_vec(o, nlist_.row_start_); put_vec(o, nlist_.nbr_); put_vec(o, nlist_.eta_); put_vec(o, nlist_.slide_);
   // A checkpoint taken right after bodies were added or removed (the runner's exchange) holds
   // the list of the previous numbering and the map to it: both are needed to carry the contact
@@ -88,25 +86,8 @@ void Simulation::load(std::istream& in) try {
 
   BodyStore b;
   DiscStore d;
-  const char* bnames[] = {"body x", "body y", "body vx", "body vy", "body theta", "body omega", "body cos theta",
-                          "body sin theta", "body fx", "body fy", "body torque", "body mass", "body inertia", "body size"};
-  {
-    int k = 0;
-    for (auto* v : {&b.x, &b.y, &b.vx, &b.vy, &b.theta, &b.omega, &b.cth, &b.sth, &b.fx, &b.fy, &b.torque, &b.mass,
-                    &b.inertia, &b.size})
-      get_vec(in, *v, bnames[k++]);
-  }
-  get_vec(in, b.id, "body id"); get_vec(in, b.first_disc, "body first_disc"); get_vec(in, b.n_discs, "body n_discs");
-  get_vec(in, b.tag, "body tag");
-  const char* dnames[] = {"disc x", "disc y", "disc ox", "disc oy", "disc wx", "disc wy", "disc r", "disc fx", "disc fy",
-                          "disc tq", "disc fax", "disc fay"};
-  {
-    int k = 0;
-    for (auto* v : {&d.x, &d.y, &d.ox, &d.oy, &d.wx, &d.wy, &d.r, &d.fx, &d.fy, &d.tq, &d.fax, &d.fay})
-      get_vec(in, *v, dnames[k++]);
-  }
-  get_vec(in, d.body, "disc body"); get_vec(in, d.wall_key, "disc wall_key"); get_vec(in, d.wall_eta, "disc wall_eta");
-  get_vec(in, d.wall_slide, "disc wall_slide");
+  b.for_each_array([&](const char* name, auto& v, std::size_t) { get_vec(in, v, ("body " + std::string(name)).c_str()); });
+  d.for_each_array([&](const char* name, auto& v, std::size_t) { get_vec(in, v, ("disc " + std::string(name)).c_str()); });
   std::vector<int> row_start, nbr, old_of_new;
   std::vector<double> eta;
   std::vector<std::uint8_t> slide;
@@ -117,46 +98,29 @@ void Simulation::load(std::istream& in) try {
   if (structure_changed > 1 || forces_valid > 1) bad("state flags are not 0 or 1");
   get_vec(in, old_of_new, "disc renumbering");
 
-  // ---- bodies ----
-  const std::size_t nb = b.x.size();
-  for (auto* v : {&b.y, &b.vx, &b.vy, &b.theta, &b.omega, &b.cth, &b.sth, &b.fx, &b.fy, &b.torque, &b.mass, &b.inertia,
-                  &b.size})
-    require_size(*v, nb, "a body array", "body count from body x");
-  require_size(b.id, nb, "body id", "body count");
-  require_size(b.first_disc, nb, "body first_disc", "body count");
-  require_size(b.n_discs, nb, "body n_discs", "body count");
-  require_size(b.tag, nb, "body tag", "body count");
-  {
-    int k = 0;
-    for (auto* v : {&b.x, &b.y, &b.vx, &b.vy, &b.theta, &b.omega, &b.cth, &b.sth, &b.fx, &b.fy, &b.torque})
-      require_finite(*v, bnames[k++]);
-  }
+  // ---- bodies and discs: every array sized by the count of its first, every double finite ----
+  const std::size_t nb = b.x.size(), nd = d.x.size();
+  b.for_each_array([&](const char* name, const auto& v, std::size_t per) {
+    const std::string what = "body " + std::string(name);
+    require_size(v, nb * per, what.c_str(), "body count from body x");
+    if constexpr (std::is_same_v<typename std::decay_t<decltype(v)>::value_type, double>) require_finite(v, what.c_str());
+  });
+  d.for_each_array([&](const char* name, const auto& v, std::size_t per) {
+    const std::string what = "disc " + std::string(name);
+    require_size(v, nd * per, what.c_str(), "disc count from disc x");
+    if constexpr (std::is_same_v<typename std::decay_t<decltype(v)>::value_type, double>) require_finite(v, what.c_str());
+  });
   for (std::size_t i = 0; i < nb; ++i)  // a unit vector (kept so by the engine's renormalisation)
     if (!(std::fabs(b.cth[i] * b.cth[i] + b.sth[i] * b.sth[i] - 1.0) < 1e-9))
       bad(fmt::format("body orientation {} (cos {}, sin {}) is not a unit vector", i, b.cth[i], b.sth[i]));
   require_positive(b.mass, "body mass");
   require_positive(b.inertia, "body inertia");
-  require_finite(b.size, "body size");
   if (next_id < static_cast<std::int64_t>(nb)) bad(fmt::format("next body id {} < body count {}", next_id, nb));
   for (std::size_t i = 0; i < nb; ++i) {
     if (b.id[i] < 0 || b.id[i] >= next_id || (i > 0 && b.id[i] <= b.id[i - 1]))
       bad(fmt::format("body id[{}] = {} is not increasing within [0, {})", i, b.id[i], next_id));
   }
-  // ---- discs ----
-  const std::size_t nd = d.x.size();
-  for (auto* v : {&d.y, &d.ox, &d.oy, &d.wx, &d.wy, &d.r, &d.fx, &d.fy, &d.tq, &d.fax, &d.fay})
-    require_size(*v, nd, "a disc array", "disc count from disc x");
-  require_size(d.body, nd, "disc body", "disc count");
-  require_size(d.wall_key, nd * kWallSlots, "disc wall_key", "disc count x wall slots");
-  require_size(d.wall_eta, nd * kWallSlots, "disc wall_eta", "disc count x wall slots");
-  require_size(d.wall_slide, nd * kWallSlots, "disc wall_slide", "disc count x wall slots");
-  {
-    int k = 0;
-    for (auto* v : {&d.x, &d.y, &d.ox, &d.oy, &d.wx, &d.wy}) require_finite(*v, dnames[k++]);
-  }
   require_positive(d.r, "disc r");
-  for (auto* v : {&d.fx, &d.fy, &d.tq, &d.fax, &d.fay}) require_finite(*v, "a disc force array");
-  require_finite(d.wall_eta, "disc wall_eta");
   require_flags(d.wall_slide, "disc wall_slide");
   for (std::size_t k = 0; k < d.wall_key.size(); ++k) {
     const std::int64_t key = d.wall_key[k];

@@ -21,6 +21,8 @@ using models::ContactParams;
 using models::TangentialState;
 
 namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
 // Rotates the unit vector (c, s) = (cos theta, sin theta) by the step's angle d: for the small
 // angles of a DEM step (|d| <= 1e-2 rad) by the Taylor series of cos d and sin d (truncation
 // below 3e-21, i.e. exact in double precision), else by libm; then one Newton step towards
@@ -66,48 +68,55 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   nl_params_.x_hi = params_.x_hi;
 }
 
+// Expects a spec add_body accepts (as many radii as offsets, at least one; positive density and
+// radii): add_body checks that before calling it.
+MassProperties mass_properties(const BodySpec& s) {
+  const std::size_t n = s.offsets.size();
+  MassProperties mp;
+  std::vector<double> mk(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = s.radii[k];
+    mk[k] = s.density * 4.0 / 3.0 * constants::pi * r * r * r;  // each member a solid sphere (§2.1)
+    mp.mass += mk[k];
+    mp.com += mk[k] * s.offsets[k];
+  }
+  mp.com /= mp.mass;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double r = s.radii[k];
+    const double own = s.sphere_inertia ? 0.4 * mk[k] * r * r : 0.5 * mk[k] * r * r;
+    mp.inertia += own + mk[k] * norm2(s.offsets[k] - mp.com);  // parallel-axis theorem
+  }
+  return mp;
+}
+
 int Simulation::add_body(const BodySpec& s) {
   const std::size_t n = s.offsets.size();
   if (n == 0 || s.radii.size() != n) throw_input("body", "discs", std::to_string(n), "need >= 1 disc with one radius each");
   require_positive("body", "density_kg_per_m3", s.density);
-  double m = 0.0;
-  Vec2 com{};
-  std::vector<double> mk(n);
+  for (const double r : s.radii) require_positive("body", "radius_m", r);
+  const MassProperties mp = mass_properties(s);
+  // Every array grows by one body (its discs), value-initialised (0); then the entries that are
+  // not 0 are set.
+  const std::size_t bi = b_.size_n(), d0 = d_.size_n();
+  b_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize((bi + 1) * per); });
+  d_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize((d0 + n) * per); });
+  b_.x[bi] = s.position.x; b_.y[bi] = s.position.y;
+  b_.vx[bi] = s.velocity.x; b_.vy[bi] = s.velocity.y;
+  b_.theta[bi] = s.angle; b_.omega[bi] = s.omega;
+  b_.cth[bi] = std::cos(s.angle); b_.sth[bi] = std::sin(s.angle);
+  b_.mass[bi] = mp.mass; b_.inertia[bi] = mp.inertia;
+  b_.id[bi] = next_id_++;
+  b_.first_disc[bi] = static_cast<int>(d0);
+  b_.n_discs[bi] = static_cast<int>(n);
+  b_.tag[bi] = s.tag;
+  b_.size[bi] = s.size;
   for (std::size_t k = 0; k < n; ++k) {
-    require_positive("body", "radius_m", s.radii[k]);
-    const double r = s.radii[k];
-    mk[k] = s.density * 4.0 / 3.0 * constants::pi * r * r * r;  // each member a solid sphere (§2.1)
-    m += mk[k];
-    com += mk[k] * s.offsets[k];
-  }
-  com /= m;
-  double inertia = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double r = s.radii[k];
-    const double own = s.sphere_inertia ? 0.4 * mk[k] * r * r : 0.5 * mk[k] * r * r;
-    inertia += own + mk[k] * norm2(s.offsets[k] - com);  // parallel-axis theorem
-  }
-  const int bi = static_cast<int>(b_.x.size());
-  b_.x.push_back(s.position.x); b_.y.push_back(s.position.y);
-  b_.vx.push_back(s.velocity.x); b_.vy.push_back(s.velocity.y);
-  b_.theta.push_back(s.angle); b_.omega.push_back(s.omega);
-  b_.cth.push_back(std::cos(s.angle)); b_.sth.push_back(std::sin(s.angle));
-  b_.fx.push_back(0.0); b_.fy.push_back(0.0); b_.torque.push_back(0.0);
-  b_.mass.push_back(m); b_.inertia.push_back(inertia);
-  b_.id.push_back(next_id_++);
-  b_.first_disc.push_back(static_cast<int>(d_.x.size()));
-  b_.n_discs.push_back(static_cast<int>(n));
-  b_.tag.push_back(s.tag);
-  b_.size.push_back(s.size);
-  for (std::size_t k = 0; k < n; ++k) {
-    const Vec2 o = s.offsets[k] - com;
-    d_.ox.push_back(o.x); d_.oy.push_back(o.y);
-    d_.r.push_back(s.radii[k]);
-    d_.body.push_back(bi);
-    d_.x.push_back(0.0); d_.y.push_back(0.0); d_.wx.push_back(0.0); d_.wy.push_back(0.0);
-    d_.fx.push_back(0.0); d_.fy.push_back(0.0); d_.tq.push_back(0.0);
-    d_.fax.push_back(0.0); d_.fay.push_back(0.0);
-    for (int q = 0; q < kWallSlots; ++q) { d_.wall_key.push_back(-1); d_.wall_eta.push_back(0.0); d_.wall_slide.push_back(0); }
+    const std::size_t i = d0 + k;
+    const Vec2 o = s.offsets[k] - mp.com;
+    d_.ox[i] = o.x; d_.oy[i] = o.y;
+    d_.r[i] = s.radii[k];
+    d_.body[i] = static_cast<int>(bi);
+    for (int q = 0; q < kWallSlots; ++q) d_.wall_key[i * kWallSlots + q] = -1;  // empty history slot
     old_of_new_.push_back(-1);
   }
   update_disc_positions(bi, bi + 1);
@@ -116,7 +125,7 @@ int Simulation::add_body(const BodySpec& s) {
   for (auto& v : prov_tq_) v.push_back(0.0);
   structure_changed_ = true;
   forces_valid_ = false;
-  return bi;
+  return static_cast<int>(bi);
 }
 
 std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
@@ -129,52 +138,32 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   std::size_t bw = 0, dw = 0;
   std::vector<int> new_old_of_new;
   new_old_of_new.reserve(d_.x.size());
-  auto move_body = [&](std::size_t from, std::size_t to) {
-    b_.x[to] = b_.x[from]; b_.y[to] = b_.y[from]; b_.vx[to] = b_.vx[from]; b_.vy[to] = b_.vy[from];
-    b_.theta[to] = b_.theta[from]; b_.omega[to] = b_.omega[from];
-    b_.cth[to] = b_.cth[from]; b_.sth[to] = b_.sth[from];
-    b_.fx[to] = b_.fx[from]; b_.fy[to] = b_.fy[from]; b_.torque[to] = b_.torque[from];
-    b_.mass[to] = b_.mass[from]; b_.inertia[to] = b_.inertia[from]; b_.id[to] = b_.id[from];
-    b_.n_discs[to] = b_.n_discs[from]; b_.tag[to] = b_.tag[from]; b_.size[to] = b_.size[from];
-    for (std::size_t k = 0; k < prov_fx_.size(); ++k) {
-      prov_fx_[k][to] = prov_fx_[k][from]; prov_fy_[k][to] = prov_fy_[k][from]; prov_tq_[k][to] = prov_tq_[k][from];
-    }
-  };
-  auto move_disc = [&](std::size_t from, std::size_t to, int body) {
-    d_.x[to] = d_.x[from]; d_.y[to] = d_.y[from]; d_.ox[to] = d_.ox[from]; d_.oy[to] = d_.oy[from];
-    d_.wx[to] = d_.wx[from]; d_.wy[to] = d_.wy[from];
-    d_.r[to] = d_.r[from]; d_.body[to] = body;
-    d_.fx[to] = d_.fx[from]; d_.fy[to] = d_.fy[from]; d_.tq[to] = d_.tq[from];
-    d_.fax[to] = d_.fax[from]; d_.fay[to] = d_.fay[from];
-    for (int q = 0; q < kWallSlots; ++q) {
-      d_.wall_key[to * kWallSlots + q] = d_.wall_key[from * kWallSlots + q];
-      d_.wall_eta[to * kWallSlots + q] = d_.wall_eta[from * kWallSlots + q];
-      d_.wall_slide[to * kWallSlots + q] = d_.wall_slide[from * kWallSlots + q];
-    }
+  auto move = [](std::size_t from, std::size_t to) {
+    return [=](const char*, auto& v, std::size_t per) {
+      for (std::size_t q = 0; q < per; ++q) v[to * per + q] = v[from * per + q];
+    };
   };
   for (std::size_t i = 0; i < nb; ++i) {
     if (drop[i]) continue;
     const int first = b_.first_disc[i], nd = b_.n_discs[i];
-    move_body(i, bw);
+    b_.for_each_array(move(i, bw));
+    for (std::size_t k = 0; k < prov_fx_.size(); ++k) {
+      prov_fx_[k][bw] = prov_fx_[k][i]; prov_fy_[k][bw] = prov_fy_[k][i]; prov_tq_[k][bw] = prov_tq_[k][i];
+    }
     b_.first_disc[bw] = static_cast<int>(dw);
     for (int k = 0; k < nd; ++k) {
-      move_disc(first + k, dw, static_cast<int>(bw));
+      d_.for_each_array(move(static_cast<std::size_t>(first + k), dw));
+      d_.body[dw] = static_cast<int>(bw);
       new_old_of_new.push_back(old_of_new_[first + k]);
       ++dw;
     }
     ++bw;
   }
-  auto shrink = [](auto& v, std::size_t n) { v.resize(n); };
-  for (auto* v : {&b_.x, &b_.y, &b_.vx, &b_.vy, &b_.theta, &b_.omega, &b_.cth, &b_.sth, &b_.fx, &b_.fy, &b_.torque,
-                  &b_.mass, &b_.inertia, &b_.size}) shrink(*v, bw);
-  shrink(b_.id, bw); shrink(b_.first_disc, bw); shrink(b_.n_discs, bw); shrink(b_.tag, bw);
+  b_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize(bw * per); });
+  d_.for_each_array([&](const char*, auto& v, std::size_t per) { v.resize(dw * per); });
   for (auto& v : prov_fx_) v.resize(bw);
   for (auto& v : prov_fy_) v.resize(bw);
   for (auto& v : prov_tq_) v.resize(bw);
-  for (auto* v : {&d_.x, &d_.y, &d_.ox, &d_.oy, &d_.wx, &d_.wy, &d_.r, &d_.fx, &d_.fy, &d_.tq, &d_.fax, &d_.fay})
-    shrink(*v, dw);
-  shrink(d_.body, dw);
-  shrink(d_.wall_key, dw * kWallSlots); shrink(d_.wall_eta, dw * kWallSlots); shrink(d_.wall_slide, dw * kWallSlots);
   old_of_new_.swap(new_old_of_new);
   structure_changed_ = true;
   forces_valid_ = false;
@@ -305,8 +294,8 @@ void Simulation::update_thread_split() {
 
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
 // list and its history), accumulates force and torque about the disc centre into f and the
-// adhesive part into fa (2 per disc). The contact law is models::normal_force and
-// models::tangential_force, inlined.
+// adhesive part into fa (2 per disc). The contact law is models::contact_force, inlined; the
+// kernel supplies the geometry and turns its magnitudes into vectors and torques.
 template <bool kAdhesion, bool kPeriodic>
 void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out) {
   const ContactParams cp = params_.interactions[0].contact;
@@ -348,33 +337,36 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
       const double inv = 1.0 / dist;
       const double nx = dx * inv, ny = dy * inv;  // from j to i
       const double overlap = rsum - dist;
-      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
-      if (overlap > 0.0) {
+      const bool touching = overlap > 0.0;
+      double li = 0.0, lj = 0.0, vn = 0.0, vt = 0.0, mred = 0.0;
+      if (touching) {
         ++nc;
         const PackedVel vj = V[j];
-        const double li = pi.r - 0.5 * overlap, lj = pj.r - 0.5 * overlap;  // centre to contact point
+        li = pi.r - 0.5 * overlap;  // centre to contact point
+        lj = pj.r - 0.5 * overlap;
         // relative velocity of the contact points: v_c + w x (lever), lever -li n on i, +lj n on j
         const double vrx = (vi.vx + vi.w * li * ny) - (vj.vx - vj.w * lj * ny);
         const double vry = (vi.vy - vi.w * li * nx) - (vj.vy + vj.w * lj * nx);
-        const double vn = vrx * nx + vry * ny;
-        const double vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
-        const double mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
-        const double fn = models::normal_force(cp, overlap, vn, mred);
-        TangentialState st{eta[e], sl[e] != 0};
-        const double ft = models::tangential_force(cp, st, vt, fn, dt, mred);
-        eta[e] = st.eta; sl[e] = st.sliding;
-        fnx = fn * nx - ft * ny;
-        fny = fn * ny + ft * nx;
-        ti = -li * ft;
-        tj = -lj * ft;
-      } else if (sl[e] != 0 || eta[e] != 0.0) {
-        eta[e] = 0.0; sl[e] = 0;
+        vn = vrx * nx + vry * ny;
+        vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
+        mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
+      }
+      // History is written where the contact is, or where an opened contact still holds some.
+      const bool had = sl[e] != 0 || eta[e] != 0.0;
+      TangentialState st{eta[e], sl[e] != 0};
+      const models::ContactForce c = models::contact_force<kAdhesion>(cp, hp, pi.r, pj.r, overlap, vn, vt, mred, dt, st);
+      if (touching || had) { eta[e] = st.eta; sl[e] = st.sliding; }
+      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
+      if (touching) {
+        fnx = c.fn * nx - c.ft * ny;
+        fny = c.fn * ny + c.ft * nx;
+        ti = -li * c.ft;
+        tj = -lj * c.ft;
       }
       if constexpr (kAdhesion) {
-        const double fad = models::hamaker_force(hp, pi.r, pj.r, -overlap);
-        fnx -= fad * nx; fny -= fad * ny;
-        faxi -= fad * nx; fayi -= fad * ny;
-        fa[2 * j] += fad * nx; fa[2 * j + 1] += fad * ny;
+        fnx -= c.fa * nx; fny -= c.fa * ny;
+        faxi -= c.fa * nx; fayi -= c.fa * ny;
+        fa[2 * j] += c.fa * nx; fa[2 * j + 1] += c.fa * ny;
       }
       fxi += fnx; fyi += fny; tqi += ti;
       f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += tj;
@@ -517,21 +509,19 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
     const int bi = d_.body[i];
     for (const auto& h : hits) {
       touched = true;
-      double fnx = 0, fny = 0;
-      const double fa = models::hamaker_force(ia.adhesion, r, std::numeric_limits<double>::infinity(), h.gap);
-      if (h.gap < 0.0) {
+      const double overlap = -h.gap;
+      const bool touching = overlap > 0.0;
+      const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+      double l = 0.0, vn = 0.0, vt = 0.0;
+      TangentialState st{};
+      if (touching) {
         ++nc;
-        const double overlap = -h.gap;
-        const double l = r - 0.5 * overlap;
+        l = r - 0.5 * overlap;  // centre to contact point
         const double rx = d_.wx[i] - l * h.normal.x, ry = d_.wy[i] - l * h.normal.y;
         const double vrx = b_.vx[bi] - b_.omega[bi] * ry - h.velocity.x;
         const double vry = b_.vy[bi] + b_.omega[bi] * rx - h.velocity.y;
-        const double vn = vrx * h.normal.x + vry * h.normal.y;
-        const double vt = -vrx * h.normal.y + vry * h.normal.x;
-        const double m = b_.mass[bi];
-        const double fn = models::normal_force(ia.contact, overlap, vn, m);
-        const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
-        TangentialState st{};
+        vn = vrx * h.normal.x + vry * h.normal.y;
+        vt = -vrx * h.normal.y + vry * h.normal.x;
         for (int q = 0; q < kWallSlots; ++q) {
           if (d_.wall_key[i * kWallSlots + q] == key) {
             st.eta = d_.wall_eta[i * kWallSlots + q];
@@ -539,16 +529,22 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
             break;
           }
         }
-        const double ft = models::tangential_force(ia.contact, st, vt, fn, dt, m);
+      }
+      // A wall has infinite mass and radius: the reduced mass is the body's. Adhesion is always
+      // evaluated (hamaker_force is 0 for A = 0): walls are few, and this keeps the sums as they were.
+      const models::ContactForce cf = models::contact_force<true>(ia.contact, ia.adhesion, r, kInf, overlap, vn, vt,
+                                                                  b_.mass[bi], dt, st);
+      double fnx = 0, fny = 0;
+      if (touching) {
         if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
           new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
         }
-        fnx = fn * h.normal.x - ft * h.normal.y;
-        fny = fn * h.normal.y + ft * h.normal.x;
-        tq += -l * ft;
+        fnx = cf.fn * h.normal.x - cf.ft * h.normal.y;
+        fny = cf.fn * h.normal.y + cf.ft * h.normal.x;
+        tq += -l * cf.ft;
       }
-      fnx -= fa * h.normal.x; fny -= fa * h.normal.y;
-      fax -= fa * h.normal.x; fay -= fa * h.normal.y;
+      fnx -= cf.fa * h.normal.x; fny -= cf.fa * h.normal.y;
+      fax -= cf.fa * h.normal.x; fay -= cf.fa * h.normal.y;
       fx += fnx; fy += fny;
     }
   }
@@ -692,7 +688,7 @@ Energy Simulation::energy() const {
       if (params_.periodic_x) dx -= L * std::nearbyint(dx / L);
       const double dy = d_.y[i] - d_.y[j];
       const double ov = d_.r[i] + d_.r[j] - std::sqrt(dx * dx + dy * dy);
-      if (ov > 0) e.elastic += 0.5 * cp.k * ov * ov + 0.5 * cp.ks * nlist_.eta_[k] * nlist_.eta_[k];
+      e.elastic += models::contact_energy(cp, ov, nlist_.eta_[k]);
     }
   }
   std::vector<geometry::WallHit> hits;
@@ -703,10 +699,11 @@ Energy Simulation::energy() const {
       const auto& wc = params_.interactions[walls_[w].interaction].contact;
       for (auto& h : hits) {
         if (h.gap >= 0) continue;
-        e.elastic += 0.5 * wc.k * h.gap * h.gap;
         const std::int64_t key = (static_cast<std::int64_t>(w) << 40) | h.key;
+        double eta = 0.0;  // a contact beyond the history slots has none
         for (int q = 0; q < kWallSlots; ++q)
-          if (d_.wall_key[i * kWallSlots + q] == key) e.elastic += 0.5 * wc.ks * std::pow(d_.wall_eta[i * kWallSlots + q], 2);
+          if (d_.wall_key[i * kWallSlots + q] == key) eta = d_.wall_eta[i * kWallSlots + q];
+        e.elastic += models::contact_energy(wc, -h.gap, eta);
       }
     }
   }

@@ -84,6 +84,17 @@ struct BodySpec {
   double size = 0.0;            // caller's size measure [m]
 };
 
+// Mass [kg], centre of mass [m] (in the frame of the spec's offsets) and moment of inertia about
+// it [kg m^2] of a body spec: each member a solid sphere of its radius (thesis §2.1), or a disc
+// if !sphere_inertia, combined by the parallel-axis theorem. The one place a cluster's mass is
+// computed; add_body uses it.
+struct MassProperties {
+  double mass = 0.0;
+  Vec2 com{};
+  double inertia = 0.0;
+};
+MassProperties mass_properties(const BodySpec& spec);
+
 struct Energy {
   double kinetic = 0.0;   // translational + rotational [J]
   double elastic = 0.0;   // normal + tangential springs of open contacts [J]

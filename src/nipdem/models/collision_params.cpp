@@ -40,6 +40,16 @@ double gamma_from_restitution(double k, double m_red, double e, DampingConventio
   return std::sqrt(4.0 * m_red * k / (4.0 * w * w + 1.0));
 }
 
+ContactParams contact_params(double k, double restitution, double m_red, double mu_s, double mu_d, DampingConvention c) {
+  ContactParams p;
+  p.k = k;
+  p.gamma = gamma_from_restitution(k, m_red, restitution, c);
+  p.ks = 2.0 * k / 7.0;  // eq. 4.3.11 with c = 1
+  p.mu_s = mu_s;
+  p.mu_d = mu_d;
+  return p;
+}
+
 double restitution(double k, double gamma, double m_red, DampingConvention c) {
   if (gamma == 0.0) return 1.0;
   const double w = 0.5 * std::sqrt(4.0 * m_red * k / (gamma * gamma) - 1.0);

@@ -1,8 +1,11 @@
 // From material data to linear spring-dashpot parameters, thesis §4.2.2 and §2.2.2:
 // Hertz stiffness (eqs. 4.2.7-4.2.13), damping from restitution and contact time
 // (eqs. 2.2.7-2.2.8), tangential spring ks = 2k/7 (eq. 4.3.11) and the stability bound of
-// Newmark purely explicit (eq. 4.2.25). See docs/contact.md for the eq. 2.2.7 erratum.
+// Newmark purely explicit (eq. 4.2.25); contact_params, the one derivation of a contact's
+// parameters from (k, e, m_red, mu_s, mu_d). See docs/contact.md for the eq. 2.2.7 erratum.
 #pragma once
+
+#include "nipdem/models/contact.hpp"
 
 namespace nipdem::models {
 
@@ -31,6 +34,12 @@ enum class DampingConvention { physical, thesis };
 
 // gamma [N s/m] giving restitution e for stiffness k and reduced mass m (0 < e <= 1).
 double gamma_from_restitution(double k, double m_red, double e, DampingConvention c = DampingConvention::physical);
+// The linear contact of one collision type (eq. 2.2.5 with eqs. 2.2.9-2.2.11): stiffness k [N/m]
+// as given, gamma [N s/m] from the restitution e at reduced mass m_red [kg] (eqs. 2.2.7-2.2.8),
+// ks = 2k/7 (eq. 4.3.11 with c = 1), static and dynamic friction mu_s, mu_d [-]; no tangential
+// damping, damping not mass-proportional (the thesis model).
+ContactParams contact_params(double k, double restitution, double m_red, double mu_s, double mu_d,
+                             DampingConvention c = DampingConvention::physical);
 // Restitution and contact time of a linear spring-dashpot collision (underdamped only).
 double restitution(double k, double gamma, double m_red, DampingConvention c = DampingConvention::physical);
 double contact_time(double k, double gamma, double m_red);

@@ -1,8 +1,17 @@
 // Contact force laws of thesis §2.2: linear spring-dashpot normal force and a tangential
-// spring capped by static/dynamic Coulomb friction. Pure functions, no state but what the
-// caller stores per contact (tangential stretch eta and the sliding flag).
+// spring capped by static/dynamic Coulomb friction, composed with Hamaker adhesion (§2.3) into
+// one contact between two surfaces (contact_force), and the elastic energy such a contact
+// stores (contact_energy). Pure functions, no state but what the caller stores per contact
+// (tangential stretch eta and the sliding flag).
+//
+// Why one composition: the engine evaluates this law in its disc-disc pair kernel and in its
+// disc-wall loop, and energy() reads the springs back; all three call the functions below, so
+// the law is written once. The geometry (overlap, normal, lever arms, the relative velocity of
+// the contact points) and where the history is stored stay with the callers, which differ.
 #pragma once
 #include <cmath>
+
+#include "nipdem/models/hamaker.hpp"
 
 namespace nipdem::models {
 
@@ -25,9 +34,13 @@ struct TangentialState {
   bool sliding = false;  // true while the contact slides with dynamic friction
 };
 
+// The forces of one contact on the body whose outward normal is n (the other body gets their
+// negatives): the vector force is fn n + ft t - fa n with t = perp(n) = (-n_y, n_x), and the
+// torque about that body's centre is -l ft for a lever l from its centre to the contact point.
 struct ContactForce {
-  double fn = 0.0;  // normal force on the body whose outward normal is n [N] (>0 repulsive)
-  double ft = 0.0;  // tangential force along t = perp(n) on the same body [N]
+  double fn = 0.0;  // spring-dashpot normal force [N] (> 0 repulsive); 0 unless the surfaces overlap
+  double ft = 0.0;  // tangential force along t [N]; 0 unless the surfaces overlap
+  double fa = 0.0;  // Hamaker attraction, a magnitude acting along -n [N]; 0 without adhesion
 };
 
 // Linear spring-dashpot normal force, eq. 2.2.5 with alpha = beta = 1:
@@ -65,6 +78,40 @@ inline double tangential_force(const ContactParams& p, TangentialState& st, doub
   const double f = std::copysign(p.mu_d * load, f_trial);
   st.eta = -(f + gt * v_t) / p.ks;
   return f;
+}
+
+// One contact between two surfaces, the composition of the three laws above: the normal
+// spring-dashpot (eq. 2.2.5), the tangential Coulomb spring with its history (eqs. 2.2.9-2.2.11)
+// and, if kAdhesion, Hamaker attraction (eq. 2.3.2).
+//   overlap: xi [m], > 0 while the surfaces overlap, else minus the gap;
+//   r1, r2: radii of the two spheres for Hamaker [m] (r2 = +inf for a wall);
+//   v_n, v_t: relative velocity of the contact points, separating normal and tangential
+//             components [m/s] (read only while overlapping: callers may pass 0 otherwise);
+//   m_red: reduced mass of the pair [kg] (used only if cp.mass_proportional); dt: step [s];
+//   st: the contact's tangential history, advanced while overlapping and reset to empty when
+//       the contact is open (the history of a contact ends the moment it opens).
+// kAdhesion = false is the plain contact law (hp is not read, fa = 0); a template parameter so
+// that the engine's kernels compile without the adhesion branch.
+template <bool kAdhesion>
+inline ContactForce contact_force(const ContactParams& cp, const HamakerParams& hp, double r1, double r2, double overlap,
+                                  double v_n, double v_t, double m_red, double dt, TangentialState& st) {
+  ContactForce f;
+  if (overlap > 0.0) {
+    f.fn = normal_force(cp, overlap, v_n, m_red);
+    f.ft = tangential_force(cp, st, v_t, f.fn, dt, m_red);
+  } else {
+    st = TangentialState{};
+  }
+  if constexpr (kAdhesion) f.fa = hamaker_force(hp, r1, r2, -overlap);
+  return f;
+}
+
+// Elastic energy stored in one contact [J]: the normal spring 1/2 k xi^2 (eq. 2.2.5, alpha = 1)
+// plus the tangential spring 1/2 ks eta^2 (eq. 2.2.10); 0 for an open contact (overlap <= 0).
+// Its derivative with respect to the overlap is the spring part of normal_force.
+inline double contact_energy(const ContactParams& p, double overlap, double eta) {
+  if (!(overlap > 0.0)) return 0.0;
+  return 0.5 * p.k * overlap * overlap + 0.5 * p.ks * eta * eta;
 }
 
 }  // namespace nipdem::models

@@ -484,11 +484,7 @@ std::vector<engine::Interaction> make_interactions(const NipConfig& c) {
   auto make = [&](const char* name, const CollisionType& t, double mred, double adh_force, bool wall) {
     engine::Interaction ia;
     ia.name = name;
-    ia.contact.k = t.k * c.stiffness_scale;
-    ia.contact.gamma = models::gamma_from_restitution(ia.contact.k, mred, t.restitution, c.damping);
-    ia.contact.ks = 2.0 * ia.contact.k / 7.0;  // eq. 4.3.11 with c = 1
-    ia.contact.mu_s = t.mu_s;
-    ia.contact.mu_d = t.mu_d;
+    ia.contact = models::contact_params(t.k * c.stiffness_scale, t.restitution, mred, t.mu_s, t.mu_d, c.damping);
     ia.adhesion = base;
     // Hamaker coefficient from the force of a d50 toner at contact (eq. 2.3.2 inverted).
     ia.adhesion.hamaker_J = adh_force > 0.0 ? models::hamaker_for_contact_force(base, r50, wall ? kInf : r50, adh_force) : 0.0;
