@@ -532,20 +532,12 @@ TimeStep choose_time_step(const NipConfig& c) {
   const ClusterTemplate& t = find_template(c.templates, c.cluster, c.file, "toner.cluster");
   const double dmin = c.size.d_min();
   const engine::BodySpec b = make_toner(t, dmin, c.density);
-  double m = 0, lever = 0, rmax = 0;
-  Vec2 com{};
+  const engine::MassProperties mp = engine::mass_properties(b);  // the engine's own mass and inertia
+  const double m = mp.mass, I = mp.inertia;
+  double lever = 0, rmax = 0;
   for (std::size_t k = 0; k < b.radii.size(); ++k) {
-    const double mk = c.density * 4.0 / 3.0 * pi * std::pow(b.radii[k], 3);
-    m += mk;
-    com += mk * b.offsets[k];
-  }
-  com /= m;
-  double I = 0;
-  for (std::size_t k = 0; k < b.radii.size(); ++k) {
-    const double mk = c.density * 4.0 / 3.0 * pi * std::pow(b.radii[k], 3);
-    I += 0.4 * mk * b.radii[k] * b.radii[k] + mk * norm2(b.offsets[k] - com);
-    lever = std::max(lever, norm(b.offsets[k] - com));
-    rmax = std::max(rmax, norm(b.offsets[k] - com) + b.radii[k]);
+    lever = std::max(lever, norm(b.offsets[k] - mp.com));
+    rmax = std::max(rmax, norm(b.offsets[k] - mp.com) + b.radii[k]);
   }
   const double m_n = 1.0 / (1.0 / m + lever * lever / I);  // normal direction, worst case
   const double m_t = 1.0 / (1.0 / m + rmax * rmax / I);    // tangential direction, worst case
