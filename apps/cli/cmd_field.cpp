@@ -61,40 +61,18 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->add_option("--x", po->x, "x [m] along the process direction, 0 at the magnet edge")->required();
   probe->add_option("--y", po->y, "y [m] above the imaging-roller surface")->required();
   probe->callback([po] {
-    require_range("field probe", "--x", po->x, -1.0, 1.0);
-    require_range("field probe", "--y", po->y, -1.0, 1.0);
-    nip::check_field_options(po->c.field, "field probe");
-    const nip::FieldSetup s = nip::make_field_setup(po->c.field);
-    const auto smp = s.field->at({po->x, po->y});
-    const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
-    const Vec2 F = magnet::dipole_force(m, smp);
+    const nlohmann::json j = nip::field_probe(po->c.field, po->x, po->y);
     if (po->c.json) {
-      nlohmann::json j{{"preset", po->c.field.preset},
-                       {"source", s.field->describe()},
-                       {"x_m", po->x},
-                       {"y_m", po->y},
-                       {"Bx_T", smp.B.x},
-                       {"By_T", smp.B.y},
-                       {"B_T", norm(smp.B)},
-                       {"dBx_dx_T_per_m", smp.dB.xx},
-                       {"dBx_dy_T_per_m", smp.dB.xy},
-                       {"dBy_dx_T_per_m", smp.dB.yx},
-                       {"dBy_dy_T_per_m", smp.dB.yy},
-                       {"radius_m", s.radius_m},
-                       {"mx_Am2", m.x},
-                       {"my_Am2", m.y},
-                       {"moment_Am2", norm(m)},
-                       {"Fx_N", F.x},
-                       {"Fy_N", F.y},
-                       {"force_N", norm(F)}};
       cli::print_json(j.dump());
     } else {
-      std::printf("%s\n", s.field->describe().c_str());
-      std::printf("  point          (%g, %g) m\n", po->x, po->y);
-      std::printf("  B              (%.6g, %.6g) T, |B| = %.6g T\n", smp.B.x, smp.B.y, norm(smp.B));
-      std::printf("  grad B         [[%.6g, %.6g], [%.6g, %.6g]] T/m\n", smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy);
-      std::printf("  toner R        %g m, moment (%.4g, %.4g) A m^2\n", s.radius_m, m.x, m.y);
-      std::printf("  magnet force   (%.6g, %.6g) N, |F| = %.6g N\n", F.x, F.y, norm(F));
+      auto d = [&](const char* k) { return j[k].get<double>(); };
+      std::printf("%s\n", j["source"].get<std::string>().c_str());
+      std::printf("  point          (%g, %g) m\n", d("x_m"), d("y_m"));
+      std::printf("  B              (%.6g, %.6g) T, |B| = %.6g T\n", d("Bx_T"), d("By_T"), d("B_T"));
+      std::printf("  grad B         [[%.6g, %.6g], [%.6g, %.6g]] T/m\n", d("dBx_dx_T_per_m"), d("dBx_dy_T_per_m"),
+                  d("dBy_dx_T_per_m"), d("dBy_dy_T_per_m"));
+      std::printf("  toner R        %g m, moment (%.4g, %.4g) A m^2\n", d("radius_m"), d("mx_Am2"), d("my_Am2"));
+      std::printf("  magnet force   (%.6g, %.6g) N, |F| = %.6g N\n", d("Fx_N"), d("Fy_N"), d("force_N"));
     }
   });
 

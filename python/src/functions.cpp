@@ -106,22 +106,7 @@ std::string force_dipole(const DipoleArgs& a) {
   return j.dump();
 }
 
-std::string field_probe(const FieldArgs& f, double x, double y) {
-  require_range("field probe", "--x", x, -1.0, 1.0);
-  require_range("field probe", "--y", y, -1.0, 1.0);
-  nip::check_field_options(f, "field probe");
-  const nip::FieldSetup s = nip::make_field_setup(f);
-  const auto smp = s.field->at({x, y});
-  const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
-  const Vec2 F = magnet::dipole_force(m, smp);
-  json j{{"preset", f.preset},         {"source", s.field->describe()}, {"x_m", x},
-         {"y_m", y},                   {"Bx_T", smp.B.x},                {"By_T", smp.B.y},
-         {"B_T", norm(smp.B)},         {"dBx_dx_T_per_m", smp.dB.xx},    {"dBx_dy_T_per_m", smp.dB.xy},
-         {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius_m},
-         {"mx_Am2", m.x},              {"my_Am2", m.y},                  {"moment_Am2", norm(m)},
-         {"Fx_N", F.x},                {"Fy_N", F.y},                    {"force_N", norm(F)}};
-  return j.dump();
-}
+std::string field_probe(const FieldArgs& f, double x, double y) { return nip::field_probe(f, x, y).dump(); }
 
 std::string field_export(const FieldArgs& f, double x0, double x1, int nx, double y0, double y1, int ny, const std::string& out) {
   // the checks of `nipdem field export`, plus those of the probe's magnet options

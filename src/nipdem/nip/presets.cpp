@@ -57,4 +57,20 @@ FieldSetup make_field_setup(const FieldOptions& o) {
   }
   return s;
 }
+
+nlohmann::json field_probe(const FieldOptions& o, double x, double y) {
+  require_range("field probe", "--x", x, -1.0, 1.0);
+  require_range("field probe", "--y", y, -1.0, 1.0);
+  check_field_options(o, "field probe");
+  const FieldSetup s = make_field_setup(o);
+  const auto smp = s.field->at({x, y});
+  const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
+  const Vec2 F = magnet::dipole_force(m, smp);
+  return {{"preset", o.preset},         {"source", s.field->describe()}, {"x_m", x},
+          {"y_m", y},                   {"Bx_T", smp.B.x},                {"By_T", smp.B.y},
+          {"B_T", norm(smp.B)},         {"dBx_dx_T_per_m", smp.dB.xx},    {"dBx_dy_T_per_m", smp.dB.xy},
+          {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius_m},
+          {"mx_Am2", m.x},              {"my_Am2", m.y},                  {"moment_Am2", norm(m)},
+          {"Fx_N", F.x},                {"Fy_N", F.y},                    {"force_N", norm(F)}};
+}
 }  // namespace nipdem::nip

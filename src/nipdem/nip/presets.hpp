@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "nipdem/models/magnet_field.hpp"
 #include "nipdem/models/magnetisation.hpp"
 
@@ -52,4 +54,10 @@ struct FieldSetup {
 // The field, toner and radius of `o` (checked with check_field_options first); throws InputError
 // for magnet overrides given with a map, or a map that does not read.
 FieldSetup make_field_setup(const FieldOptions& o);
+// `field probe` (CLI and Python): B, grad B, the induced moment (eq. 4.5.1 magnetisation curve)
+// and the magnet force (m . grad) B (eq. 2.4.34) on a toner of the options' radius at (x, y) [m];
+// checks x, y and the options (InputError naming `field probe` and the option). JSON keys as
+// docs/cli-contract.md: preset, source, x_m, y_m, Bx_T, By_T, B_T, dB*_d*_T_per_m, radius_m,
+// mx_Am2, my_Am2, moment_Am2, Fx_N, Fy_N, force_N.
+nlohmann::json field_probe(const FieldOptions& o, double x_m, double y_m);
 }  // namespace nipdem::nip
