@@ -14,6 +14,7 @@
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
+#include "nipdem/engine/pair_batch.hpp"
 
 namespace nipdem::engine {
 
@@ -24,16 +25,20 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Rotates the unit vector (c, s) = (cos theta, sin theta) by the step's angle d: for the small
-// angles of a DEM step (|d| <= 1e-2 rad) by the Taylor series of cos d and sin d (truncation
-// below 3e-21, i.e. exact in double precision), else by libm; then one Newton step towards
-// c^2 + s^2 = 1, so rounding does not accumulate in the length. Same state, same result:
-// the engine stays bitwise reproducible and resumable (c, s are checkpointed).
+// angles of a DEM step (|d| <= 1e-2 rad) by the Taylor polynomials of cos d and sin d to d^6 and
+// d^7 (truncation below 3e-21, i.e. exact in double precision), written in Horner form with
+// constant coefficients (no division: five divides per body and step were 15 % of a packing's
+// step, docs/performance.md), else by libm; then one Newton step towards c^2 + s^2 = 1, so
+// rounding does not accumulate in the length. Same state, same result: the engine stays bitwise
+// reproducible and resumable (c, s are checkpointed).
 inline void rotate_by(double& c, double& s, double d) {
   double cd, sd;
   if (std::fabs(d) <= 1e-2) {
+    constexpr double c2 = -1.0 / 2.0, c4 = 1.0 / 24.0, c6 = -1.0 / 720.0;
+    constexpr double s3 = -1.0 / 6.0, s5 = 1.0 / 120.0, s7 = -1.0 / 5040.0;
     const double d2 = d * d;
-    cd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
-    sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0)));
+    cd = 1.0 + d2 * (c2 + d2 * (c4 + d2 * c6));
+    sd = d + d * d2 * (s3 + d2 * (s5 + d2 * s7));
   } else {
     cd = std::cos(d);
     sd = std::sin(d);
@@ -274,6 +279,9 @@ void Simulation::update_thread_split() {
   if (split_builds_ == nlist_.builds() && split_threads_ == nt && static_cast<int>(nlist_.size()) == n) return;
   split_builds_ = nlist_.builds();
   split_threads_ = nt;
+  entry_row_.resize(nlist_.pair_count());
+  for (int i = 0; i < n; ++i)
+    std::fill(entry_row_.begin() + nlist_.row_start_[i], entry_row_.begin() + nlist_.row_start_[i + 1], i);
   split_.assign(nt + 1, 0);
   reach_hi_.assign(nt, 0);
   const auto& rs = nlist_.row_start_;
@@ -294,8 +302,12 @@ void Simulation::update_thread_split() {
 
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
 // list and its history), accumulates force and torque about the disc centre into f and the
-// adhesive part into fa (2 per disc). The contact law is models::contact_force, inlined; the
-// kernel supplies the geometry and turns its magnitudes into vectors and torques.
+// adhesive part into fa (2 per disc). In three passes over batches of interacting pairs
+// (engine/pair_batch.hpp): a distance test per list entry that collects the pairs within
+// contact or adhesion range (and clears the history of those out of it); the contact law
+// (models::contact_force) on the whole batch at once, vectorised; then the sums into the discs,
+// scalar and in list order, the same additions in the same order as one loop over the list
+// would make (a row's own sum is accumulated apart and added when the row ends).
 template <bool kAdhesion, bool kPeriodic>
 void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out) {
   const ContactParams cp = params_.interactions[0].contact;
@@ -303,77 +315,75 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   const double dt = params_.dt;
   const double L = params_.x_hi - params_.x_lo, hL = 0.5 * L;
   const double reach = pair_reach_;
-  const bool mass_prop = cp.mass_proportional;
   const PackedDisc* P = pdisc_.data();
   const PackedVel* V = pvel_.data();
   const int* rs = nlist_.row_start_.data();
   const int* nb = nlist_.nbr_.data();
   double* eta = nlist_.eta_.data();
   std::uint8_t* sl = nlist_.slide_.data();
+  detail::PairBatch batch;
+  detail::PairBatch& B = batch;
+  int n = 0;
   std::int64_t nc = 0;
-  for (int i = i0; i < i1; ++i) {
-    const PackedDisc pi = P[i];
-    const PackedVel vi = V[i];
-    double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
-    for (int e = rs[i]; e < rs[i + 1]; ++e) {
-      const int j = nb[e];
-      const PackedDisc pj = P[j];
-      double dx = pi.x - pj.x;
-      const double dy = pi.y - pj.y;
-      if constexpr (kPeriodic) {  // minimum image; |dx| < 1.5 L since centres are wrapped
-        dx = dx > hL ? dx - L : dx;
-        dx = dx < -hL ? dx + L : dx;
-      }
-      const double rsum = pi.r + pj.r;
-      const double d2 = dx * dx + dy * dy;
-      const double rc = rsum + reach;
-      if (d2 >= rc * rc) {
-        // Reset history only where there is some: most listed pairs are apart and stay so,
-        // and a read keeps their cache lines clean (no write-back).
-        if (sl[e] != 0 || eta[e] != 0.0) { eta[e] = 0.0; sl[e] = 0; }
-        continue;
-      }
-      const double dist = std::sqrt(d2);
-      const double inv = 1.0 / dist;
-      const double nx = dx * inv, ny = dy * inv;  // from j to i
-      const double overlap = rsum - dist;
-      const bool touching = overlap > 0.0;
-      double li = 0.0, lj = 0.0, vn = 0.0, vt = 0.0, mred = 0.0;
-      if (touching) {
-        ++nc;
-        const PackedVel vj = V[j];
-        li = pi.r - 0.5 * overlap;  // centre to contact point
-        lj = pj.r - 0.5 * overlap;
-        // relative velocity of the contact points: v_c + w x (lever), lever -li n on i, +lj n on j
-        const double vrx = (vi.vx + vi.w * li * ny) - (vj.vx - vj.w * lj * ny);
-        const double vry = (vi.vy - vi.w * li * nx) - (vj.vy + vj.w * lj * nx);
-        vn = vrx * nx + vry * ny;
-        vt = -vrx * ny + vry * nx;  // t = perp(n) = (-ny, nx)
-        mred = mass_prop ? pi.m * pj.m / (pi.m + pj.m) : 0.0;
-      }
-      // History is written where the contact is, or where an opened contact still holds some.
-      const bool had = sl[e] != 0 || eta[e] != 0.0;
-      TangentialState st{eta[e], sl[e] != 0};
-      const models::ContactForce c = models::contact_force<kAdhesion>(cp, hp, pi.r, pj.r, overlap, vn, vt, mred, dt, st);
-      if (touching || had) { eta[e] = st.eta; sl[e] = st.sliding; }
-      double fnx = 0.0, fny = 0.0, ti = 0.0, tj = 0.0;
-      if (touching) {
-        fnx = c.fn * nx - c.ft * ny;
-        fny = c.fn * ny + c.ft * nx;
-        ti = -li * c.ft;
-        tj = -lj * c.ft;
-      }
-      if constexpr (kAdhesion) {
-        fnx -= c.fa * nx; fny -= c.fa * ny;
-        faxi -= c.fa * nx; fayi -= c.fa * ny;
-        fa[2 * j] += c.fa * nx; fa[2 * j + 1] += c.fa * ny;
-      }
-      fxi += fnx; fyi += fny; tqi += ti;
-      f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += tj;
+  // the row whose own sum is open, and that sum
+  int row = -1;
+  double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
+  auto close_row = [&] {
+    if (row < 0) return;
+    f[row].fx += fxi; f[row].fy += fyi; f[row].tq += tqi;
+    if constexpr (kAdhesion) { fa[2 * row] += faxi; fa[2 * row + 1] += fayi; }
+    fxi = fyi = tqi = faxi = fayi = 0.0;
+  };
+  auto flush = [&] {
+    for (int k = 0; k < n; ++k) {  // gather what the law reads
+      const int i = B.i[k], j = B.j[k], e = B.e[k];
+      B.ri[k] = P[i].r; B.rj[k] = P[j].r; B.mi[k] = P[i].m; B.mj[k] = P[j].m;
+      B.vix[k] = V[i].vx; B.viy[k] = V[i].vy; B.wi[k] = V[i].w;
+      B.vjx[k] = V[j].vx; B.vjy[k] = V[j].vy; B.wj[k] = V[j].w;
+      B.eta[k] = eta[e]; B.slide[k] = sl[e];
     }
-    f[i].fx += fxi; f[i].fy += fyi; f[i].tq += tqi;
-    if constexpr (kAdhesion) { fa[2 * i] += faxi; fa[2 * i + 1] += fayi; }
+    detail::compute_pair_batch(cp, hp, dt, kAdhesion, n, B);
+    for (int k = 0; k < n; ++k) {  // sums, in list order
+      const int i = B.i[k], j = B.j[k], e = B.e[k];
+      if (i != row) { close_row(); row = i; }
+      eta[e] = B.eta[k]; sl[e] = static_cast<std::uint8_t>(B.slide[k]);
+      nc += static_cast<std::int64_t>(B.touching[k]);
+      const double fnx = B.fx[k], fny = B.fy[k];
+      fxi += fnx; fyi += fny; tqi += B.ti[k];
+      f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += B.tj[k];
+      if constexpr (kAdhesion) {
+        faxi -= B.fax[k]; fayi -= B.fay[k];
+        fa[2 * j] += B.fax[k]; fa[2 * j + 1] += B.fay[k];
+      }
+    }
+    n = 0;
+  };
+  // One flat loop over the rows' entries, without a branch on the data: the test's outcome
+  // (about one entry in three interacts in a packing) and the row lengths (0-6) are what a
+  // branch predictor cannot learn. An entry is always written to the batch; the count moves
+  // on only if the pair interacts.
+  const int* own = entry_row_.data();
+  for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) {
+    const int i = own[e], j = nb[e];
+    const PackedDisc& pi = P[i];
+    const PackedDisc& pj = P[j];
+    double dx = pi.x - pj.x;
+    const double dy = pi.y - pj.y;
+    if constexpr (kPeriodic) {  // minimum image; |dx| < 1.5 L since centres are wrapped
+      dx = dx > hL ? dx - L : dx;
+      dx = dx < -hL ? dx + L : dx;
+    }
+    const double rc = (pi.r + pj.r) + reach;
+    const bool interacts = dx * dx + dy * dy < rc * rc;
+    B.dx[n] = dx; B.dy[n] = dy; B.e[n] = e; B.i[n] = i; B.j[n] = j;
+    n += interacts ? 1 : 0;
+    // History of a pair out of range is reset where there is some (rare: a contact that just
+    // opened); most stay clean, and a read keeps their cache lines clean (no write-back).
+    if (!interacts & ((sl[e] != 0) | (eta[e] != 0.0))) { eta[e] = 0.0; sl[e] = 0; }
+    if (n == detail::PairBatch::kN) flush();
   }
+  flush();
+  close_row();
   nc_out = nc;
 }
 
@@ -525,7 +535,7 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
         for (int q = 0; q < kWallSlots; ++q) {
           if (d_.wall_key[i * kWallSlots + q] == key) {
             st.eta = d_.wall_eta[i * kWallSlots + q];
-            st.sliding = d_.wall_slide[i * kWallSlots + q] != 0;
+            st.sliding = d_.wall_slide[i * kWallSlots + q] != 0 ? 1.0 : 0.0;
             break;
           }
         }
@@ -537,7 +547,7 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
       double fnx = 0, fny = 0;
       if (touching) {
         if (nnew < kWallSlots) {  // more simultaneous wall contacts than slots: no history for the extra
-          new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = st.sliding; ++nnew;
+          new_key[nnew] = key; new_eta[nnew] = st.eta; new_sl[nnew] = static_cast<std::uint8_t>(st.sliding); ++nnew;
         }
         fnx = cf.fn * h.normal.x - cf.ft * h.normal.y;
         fny = cf.fn * h.normal.y + cf.ft * h.normal.x;
@@ -611,6 +621,9 @@ void Simulation::step() {
   double* cth = b_.cth.data(); double* sth = b_.sth.data();
   const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
   const double* m = b_.mass.data(); const double* I = b_.inertia.data();
+  inv_mass_.resize(nb);
+  inv_inertia_.resize(nb);
+  double* inv_m = inv_mass_.data(); double* inv_I = inv_inertia_.data();
   // One pass per body: integrate, wrap, place its discs and track the two largest disc
   // displacements since the list was built (instead of three separate passes).
   const int nt = params_.threads;
@@ -621,15 +634,20 @@ void Simulation::step() {
 #pragma omp for schedule(static)
   for (std::size_t b = 0; b < nb; ++b) {
     double dth;
+    // One division per mass and inertia, kept for the closing half-kick (a divide costs as
+    // much as ten multiplies; three per kick were most of this loop's time).
+    const double im = 1.0 / m[b], iI = 1.0 / I[b];
+    inv_m[b] = im; inv_I[b] = iI;
     if (newmark) {
       // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
-      const double ax = fx[b] / m[b], ay = fy[b] / m[b], al = tq[b] / I[b];
+      const double ax = fx[b] * im, ay = fy[b] * im, al = tq[b] * iI;
       x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
       dth = dt * om[b] + 0.5 * dt * dt * al;
       vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
     } else {
       // velocity Verlet, first half: kick by dt/2, drift by dt
-      vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
+      const double h = 0.5 * dt;
+      vx[b] += h * fx[b] * im; vy[b] += h * fy[b] * im; om[b] += h * tq[b] * iI;
       x[b] += dt * vx[b]; y[b] += dt * vy[b];
       dth = dt * om[b];
     }
@@ -668,7 +686,8 @@ void Simulation::step() {
   if (!newmark) {
 #pragma omp parallel for schedule(static) num_threads(params_.threads)
     for (std::size_t b = 0; b < nb; ++b) {
-      vx[b] += 0.5 * dt * fx[b] / m[b]; vy[b] += 0.5 * dt * fy[b] / m[b]; om[b] += 0.5 * dt * tq[b] / I[b];
+      const double h = 0.5 * dt;
+      vx[b] += h * fx[b] * inv_m[b]; vy[b] += h * fy[b] * inv_m[b]; om[b] += h * tq[b] * inv_I[b];
     }
   }
 }

@@ -31,7 +31,9 @@ struct ContactParams {
 // Per-contact history carried from step to step (eq. 2.2.11).
 struct TangentialState {
   double eta = 0.0;      // tangential spring stretch along the current tangent [m]
-  bool sliding = false;  // true while the contact slides with dynamic friction
+  // 1 while the contact slides with dynamic friction, else 0; a double (not a bool) so that the
+  // engine's batched pair kernel selects on it with the same vector instructions as on eta.
+  double sliding = 0.0;
 };
 
 // The forces of one contact on the body whose outward normal is n (the other body gets their
@@ -63,21 +65,20 @@ inline double normal_force(const ContactParams& p, double overlap, double v_n, d
 //    i.e. when the slip stops or reverses.
 inline double tangential_force(const ContactParams& p, TangentialState& st, double v_t, double fn_load,
                                double dt, double m_red) {
-  if (p.ks <= 0.0) return 0.0;
+  // Both outcomes are computed and one is selected (no branch on the data): the engine's batched
+  // pair kernel evaluates this law for several contacts per instruction (engine/pair_batch.hpp).
   const double gt = p.mass_proportional ? p.gamma_t * m_red : p.gamma_t;
   const double eta_trial = st.eta + v_t * dt;
   const double f_trial = -p.ks * eta_trial - gt * v_t;
   const double load = fn_load > 0.0 ? fn_load : 0.0;
-  const double cap = (st.sliding ? p.mu_d : p.mu_s) * load;
-  if (std::fabs(f_trial) <= cap) {
-    st.eta = eta_trial;
-    st.sliding = false;
-    return f_trial;
-  }
-  st.sliding = true;
-  const double f = std::copysign(p.mu_d * load, f_trial);
-  st.eta = -(f + gt * v_t) / p.ks;
-  return f;
+  const double cap = (st.sliding != 0.0 ? p.mu_d : p.mu_s) * load;
+  const bool stick = std::fabs(f_trial) <= cap;
+  const double f_slide = std::copysign(p.mu_d * load, f_trial);
+  const double eta_slide = -(f_slide + gt * v_t) / p.ks;
+  const bool spring = p.ks > 0.0;  // without a tangential spring: no force, history untouched
+  st.eta = spring ? (stick ? eta_trial : eta_slide) : st.eta;
+  st.sliding = spring ? (stick ? 0.0 : 1.0) : st.sliding;
+  return spring ? (stick ? f_trial : f_slide) : 0.0;
 }
 
 // One contact between two surfaces, the composition of the three laws above: the normal
@@ -95,13 +96,17 @@ inline double tangential_force(const ContactParams& p, TangentialState& st, doub
 template <bool kAdhesion>
 inline ContactForce contact_force(const ContactParams& cp, const HamakerParams& hp, double r1, double r2, double overlap,
                                   double v_n, double v_t, double m_red, double dt, TangentialState& st) {
+  // Evaluated whether or not the surfaces overlap, then selected (no branch on the data, as in
+  // tangential_force).
+  const bool touching = overlap > 0.0;
+  TangentialState s = st;
+  const double fn = normal_force(cp, overlap, v_n, m_red);
+  const double ft = tangential_force(cp, s, v_t, fn, dt, m_red);
   ContactForce f;
-  if (overlap > 0.0) {
-    f.fn = normal_force(cp, overlap, v_n, m_red);
-    f.ft = tangential_force(cp, st, v_t, f.fn, dt, m_red);
-  } else {
-    st = TangentialState{};
-  }
+  f.fn = touching ? fn : 0.0;
+  f.ft = touching ? ft : 0.0;
+  st.eta = touching ? s.eta : 0.0;
+  st.sliding = touching ? s.sliding : 0.0;
   if constexpr (kAdhesion) f.fa = hamaker_force(hp, r1, r2, -overlap);
   return f;
 }

@@ -22,22 +22,21 @@ struct HamakerParams {
 
 // Effective radius R1 R2 / (R1 + R2); R2 = +inf gives R1 (wall).
 inline double effective_radius(double r1, double r2) {
-  if (std::isinf(r2)) return r1;
-  return r1 * r2 / (r1 + r2);
+  const double both = r1 * r2 / (r1 + r2);  // (NaN for a wall, then not selected)
+  return std::isinf(r2) ? r1 : both;
 }
 
 // Attractive force magnitude [N] at surface separation s [m] (s < 0: overlapping) between
 // spheres of radii r1, r2 (r2 may be +inf for a wall). Returns 0 beyond the cut-off.
 inline double hamaker_force(const HamakerParams& p, double r1, double r2, double s) {
-  if (p.hamaker_J == 0.0 || s > p.cutoff_m) return 0.0;
-  double d;
-  if (p.distance == HamakerParams::Distance::surface) {
-    d = (s > 0.0 ? s : 0.0) + p.min_separation_m;
-  } else {
-    if (std::isinf(r2)) d = s + r1;  // centre-to-wall distance
-    else d = s + r1 + r2;            // centre-to-centre distance
-  }
-  return p.hamaker_J * effective_radius(r1, r2) / (12.0 * d * d);
+  // Every branch is computed and one selected (no branch on the data): the engine's batched
+  // pair kernel evaluates this for several pairs per instruction (engine/pair_batch.hpp).
+  const double d_surface = (s > 0.0 ? s : 0.0) + p.min_separation_m;
+  const double d_centre = std::isinf(r2) ? s + r1  // centre-to-wall distance
+                                         : s + r1 + r2;  // centre-to-centre distance
+  const double d = p.distance == HamakerParams::Distance::surface ? d_surface : d_centre;
+  const double f = p.hamaker_J * effective_radius(r1, r2) / (12.0 * d * d);
+  return (p.hamaker_J == 0.0 || s > p.cutoff_m) ? 0.0 : f;
 }
 
 // Potential energy [J] whose negative derivative w.r.t. s is -hamaker_force (attractive),
