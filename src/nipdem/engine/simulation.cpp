@@ -14,7 +14,7 @@
 
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
-#include "nipdem/engine/pair_batch.hpp"
+#include "nipdem/engine/kernels.hpp"
 
 namespace nipdem::engine {
 
@@ -24,30 +24,6 @@ using models::TangentialState;
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Rotates the unit vector (c, s) = (cos theta, sin theta) by the step's angle d: for the small
-// angles of a DEM step (|d| <= 1e-2 rad) by the Taylor polynomials of cos d and sin d to d^6 and
-// d^7 (truncation below 3e-21, i.e. exact in double precision), written in Horner form with
-// constant coefficients (no division: five divides per body and step were 15 % of a packing's
-// step, docs/performance.md), else by libm; then one Newton step towards c^2 + s^2 = 1, so
-// rounding does not accumulate in the length. Same state, same result: the engine stays bitwise
-// reproducible and resumable (c, s are checkpointed).
-inline void rotate_by(double& c, double& s, double d) {
-  double cd, sd;
-  if (std::fabs(d) <= 1e-2) {
-    constexpr double c2 = -1.0 / 2.0, c4 = 1.0 / 24.0, c6 = -1.0 / 720.0;
-    constexpr double s3 = -1.0 / 6.0, s5 = 1.0 / 120.0, s7 = -1.0 / 5040.0;
-    const double d2 = d * d;
-    cd = 1.0 + d2 * (c2 + d2 * (c4 + d2 * c6));
-    sd = d + d * d2 * (s3 + d2 * (s5 + d2 * s7));
-  } else {
-    cd = std::cos(d);
-    sd = std::sin(d);
-  }
-  const double c1 = c * cd - s * sd, s1 = s * cd + c * sd;
-  const double f = 1.5 - 0.5 * (c1 * c1 + s1 * s1);
-  c = c1 * f;
-  s = s1 * f;
-}
 }  // namespace
 
 Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
@@ -303,7 +279,7 @@ void Simulation::update_thread_split() {
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
 // list and its history), accumulates force and torque about the disc centre into f and the
 // adhesive part into fa (2 per disc). In three passes over batches of interacting pairs
-// (engine/pair_batch.hpp): a distance test per list entry that collects the pairs within
+// (engine/kernels.hpp): a distance test per list entry that collects the pairs within
 // contact or adhesion range (and clears the history of those out of it); the contact law
 // (models::contact_force) on the whole batch at once, vectorised; then the sums into the discs,
 // scalar and in list order, the same additions in the same order as one loop over the list
@@ -612,58 +588,39 @@ void Simulation::step() {
   const double dt = params_.dt;
   const std::size_t nb = b_.x.size();
   const bool periodic = params_.periodic_x;
-  const double xlo = params_.x_lo, xhi = params_.x_hi, L = params_.x_hi - params_.x_lo;
   const bool newmark = params_.integrator == Integrator::newmark_explicit;
   // The list's reference positions are only comparable if nothing was added/removed.
   const bool check_moves = !structure_changed_ && nlist_.size() == d_.x.size();
   double* x = b_.x.data(); double* y = b_.y.data(); double* vx = b_.vx.data(); double* vy = b_.vy.data();
-  double* th = b_.theta.data(); double* om = b_.omega.data();
-  double* cth = b_.cth.data(); double* sth = b_.sth.data();
+  double* om = b_.omega.data();
   const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
-  const double* m = b_.mass.data(); const double* I = b_.inertia.data();
   inv_mass_.resize(nb);
   inv_inertia_.resize(nb);
   double* inv_m = inv_mass_.data(); double* inv_I = inv_inertia_.data();
-  // One pass per body: integrate, wrap, place its discs and track the two largest disc
-  // displacements since the list was built (instead of three separate passes).
+  // Per thread, on its share of the bodies: the vectorised drift (engine/kernels.hpp), the rare
+  // large rotations, then placing the discs and tracking the two largest disc displacements
+  // since the list was built.
+  dtheta_.resize(nb);
+  const detail::BodyArrays arrays{x, y, vx, vy, b_.theta.data(), b_.omega.data(), b_.cth.data(), b_.sth.data(),
+                                  fx, fy, tq, b_.mass.data(), b_.inertia.data(), inv_m, inv_I, dtheta_.data()};
+  const detail::DriftParams drift{dt, newmark, periodic, params_.x_lo, params_.x_hi};
   const int nt = params_.threads;
   thread_disp_.assign(2 * nt, 0.0);
 #pragma omp parallel num_threads(nt)
   {
+  const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+  const std::size_t team = static_cast<std::size_t>(omp_get_num_threads());
+  const std::size_t b0 = nb * t / team, b1 = nb * (t + 1) / team;
+  detail::drift_bodies(drift, b0, b1, arrays);
   double d1 = 0.0, d2 = 0.0;
-#pragma omp for schedule(static)
-  for (std::size_t b = 0; b < nb; ++b) {
-    double dth;
-    // One division per mass and inertia, kept for the closing half-kick (a divide costs as
-    // much as ten multiplies; three per kick were most of this loop's time).
-    const double im = 1.0 / m[b], iI = 1.0 / I[b];
-    inv_m[b] = im; inv_I[b] = iI;
-    if (newmark) {
-      // eq. 4.2.17: x += dt v + dt^2/2 a_n ; v += dt a_n
-      const double ax = fx[b] * im, ay = fy[b] * im, al = tq[b] * iI;
-      x[b] += dt * vx[b] + 0.5 * dt * dt * ax; y[b] += dt * vy[b] + 0.5 * dt * dt * ay;
-      dth = dt * om[b] + 0.5 * dt * dt * al;
-      vx[b] += dt * ax; vy[b] += dt * ay; om[b] += dt * al;
-    } else {
-      // velocity Verlet, first half: kick by dt/2, drift by dt
-      const double h = 0.5 * dt;
-      vx[b] += h * fx[b] * im; vy[b] += h * fy[b] * im; om[b] += h * tq[b] * iI;
-      x[b] += dt * vx[b]; y[b] += dt * vy[b];
-      dth = dt * om[b];
-    }
-    th[b] += dth;
-    rotate_by(cth[b], sth[b], dth);
-    if (periodic) {  // a body moves far less than L per step
-      x[b] = x[b] >= xhi ? x[b] - L : x[b];
-      x[b] = x[b] < xlo ? x[b] + L : x[b];
-    }
+  for (std::size_t b = b0; b < b1; ++b) {
+    if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
     place_body(b);
     if (check_moves) {
       const int first = b_.first_disc[b], nd = b_.n_discs[b];
       for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
     }
   }
-  const int t = omp_get_thread_num();
   thread_disp_[2 * t] = d1;
   thread_disp_[2 * t + 1] = d2;
   }

@@ -187,7 +187,7 @@ class Simulation {
   std::vector<int> split_, reach_hi_;
   std::vector<int> entry_row_;  // the list row (disc i) of each list entry, for the flat pair loop
   std::vector<std::int64_t> thread_nc_;
-  std::vector<double> inv_mass_, inv_inertia_;  // per body, 1/m and 1/I of this step (scratch of step())
+  std::vector<double> inv_mass_, inv_inertia_, dtheta_;  // per body, 1/m, 1/I and the rotation of this step (scratch of step())
   std::vector<double> thread_disp_;  // per thread: two largest squared disc displacements
   int split_builds_ = -1, split_threads_ = 0;
   std::vector<std::vector<geometry::WallHit>> thread_hits_;  // per-thread wall query scratch

@@ -66,7 +66,7 @@ inline double normal_force(const ContactParams& p, double overlap, double v_n, d
 inline double tangential_force(const ContactParams& p, TangentialState& st, double v_t, double fn_load,
                                double dt, double m_red) {
   // Both outcomes are computed and one is selected (no branch on the data): the engine's batched
-  // pair kernel evaluates this law for several contacts per instruction (engine/pair_batch.hpp).
+  // pair kernel evaluates this law for several contacts per instruction (engine/kernels.hpp).
   const double gt = p.mass_proportional ? p.gamma_t * m_red : p.gamma_t;
   const double eta_trial = st.eta + v_t * dt;
   const double f_trial = -p.ks * eta_trial - gt * v_t;

@@ -30,7 +30,7 @@ inline double effective_radius(double r1, double r2) {
 // spheres of radii r1, r2 (r2 may be +inf for a wall). Returns 0 beyond the cut-off.
 inline double hamaker_force(const HamakerParams& p, double r1, double r2, double s) {
   // Every branch is computed and one selected (no branch on the data): the engine's batched
-  // pair kernel evaluates this for several pairs per instruction (engine/pair_batch.hpp).
+  // pair kernel evaluates this for several pairs per instruction (engine/kernels.hpp).
   const double d_surface = (s > 0.0 ? s : 0.0) + p.min_separation_m;
   const double d_centre = std::isinf(r2) ? s + r1  // centre-to-wall distance
                                          : s + r1 + r2;  // centre-to-centre distance
