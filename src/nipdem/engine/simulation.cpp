@@ -304,13 +304,13 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   // the row whose own sum is open, and that sum
   int row = -1;
   double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
-  auto close_row = [&] {
+  auto close_row = [&]() __attribute__((always_inline)) {
     if (row < 0) return;
     f[row].fx += fxi; f[row].fy += fyi; f[row].tq += tqi;
     if constexpr (kAdhesion) { fa[2 * row] += faxi; fa[2 * row + 1] += fayi; }
     fxi = fyi = tqi = faxi = fayi = 0.0;
   };
-  auto flush = [&] {
+  auto flush = [&]() __attribute__((always_inline)) {
     for (int k = 0; k < n; ++k) {  // gather what the law reads
       const int i = B.i[k], j = B.j[k], e = B.e[k];
       B.ri[k] = P[i].r; B.rj[k] = P[j].r; B.mi[k] = P[i].m; B.mj[k] = P[j].m;
