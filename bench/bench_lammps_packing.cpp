@@ -4,7 +4,7 @@
 // Same law, same parameters, same packing as bench_lammps_hooke.in, so disc-steps/s can be
 // compared with LAMMPS's "Loop time" run right before or after (bench/run_lammps_compare.sh).
 //
-// Usage: bench_lammps_packing [--data FILE(.gz)] [--steps N] [--warmup N] [--threads T]
+// Usage: bench_lammps_packing [--data FILE(.gz)] [--steps N] [--warmup N] [--threads T] [--run-threads R]
 //                             [--tilt-deg A] [--inertia disc|sphere] [--every N]
 // Prints parameters, git hash, throughput of the timed phase and, after it (untimed), the
 // final kinetic energy and contacts per disc for the physics cross-check with LAMMPS.
@@ -141,7 +141,7 @@ double cpu_seconds() {
 void usage() {
   std::fprintf(stderr,
                "usage: bench_lammps_packing [--data FILE(.gz)] [--steps N=20000] [--warmup N=1000] "
-               "[--threads T=1] [--tilt-deg A=0] [--inertia disc|sphere] [--every N=0]\n");
+               "[--threads T=1] [--run-threads R=0 (0: measured choice of T or 1)] [--tilt-deg A=0] [--inertia disc|sphere] [--every N=0]\n");
 }
 
 }  // namespace
@@ -151,6 +151,7 @@ int main(int argc, char** argv) {
   std::string data = "/work/shared/bench/lammps-2d-packing/packing.data.gz";
   long steps = 20000, warmup = 1000;
   int threads = 1;
+  int run_threads = 0;
   double tilt_deg = 0.0;
   bool sphere_inertia = false;
   long every = 0;
@@ -164,6 +165,7 @@ int main(int argc, char** argv) {
     else if (k == "--steps") steps = std::stol(val());
     else if (k == "--warmup") warmup = std::stol(val());
     else if (k == "--threads") threads = std::stoi(val());
+    else if (k == "--run-threads") run_threads = std::stoi(val());
     else if (k == "--tilt-deg") tilt_deg = std::stod(val());
     else if (k == "--every") every = std::stol(val());
     else if (k == "--inertia") {
@@ -172,7 +174,7 @@ int main(int argc, char** argv) {
       sphere_inertia = v == "sphere";
     } else { usage(); return 2; }
   }
-  if (steps < 1 || warmup < 0 || threads < 1 || every < 0 || !(std::fabs(tilt_deg) <= 90.0)) { usage(); return 2; }
+  if (steps < 1 || warmup < 0 || threads < 1 || run_threads < 0 || run_threads > threads || every < 0 || !(std::fabs(tilt_deg) <= 90.0)) { usage(); return 2; }
 
   Packing pk;
   try {
@@ -200,6 +202,7 @@ int main(int argc, char** argv) {
   ep.x_lo = pk.xlo;
   ep.x_hi = pk.xhi;
   ep.threads = threads;
+  ep.run_threads = run_threads;
   geometry::Wall floor, lid;
   floor.kind = lid.kind = geometry::Wall::Kind::plane;
   floor.name = "floor"; floor.point = {0.0, pk.ylo}; floor.normal = {0.0, 1.0}; floor.interaction = 1;
@@ -261,6 +264,9 @@ int main(int argc, char** argv) {
   std::printf("  final: ke_translational_J=%.6g ke_rotational_J=%.6g contacts_per_disc=%.4f (disc-disc, as "
               "LAMMPS contact/atom) all_contacts=%lld\n",
               ke_t, ke_r, contacts_per_disc(sim), static_cast<long long>(sim.contacts()));
+  const auto& tt = sim.team_tuner();
+  std::printf("  thread use: %s, %d threads at the end, %d probes, %d switches\n",
+              tt.adaptive() ? "measured (run_threads=0)" : "fixed", tt.team(), tt.probes(), tt.switches());
   std::printf("RESULT nipdem threads=%d steps=%ld wall_s=%.4f cpu_s=%.4f disc_steps_per_s=%.6g\n", threads, steps, wall, cpu, rate);
   return 0;
 }

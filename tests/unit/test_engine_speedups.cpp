@@ -22,6 +22,7 @@
 #include "nipdem/core/rng.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
+#include "nipdem/models/collision_params.hpp"
 
 using namespace nipdem;
 using namespace nipdem::engine;
@@ -188,4 +189,91 @@ TEST(WaitPolicy, TheCliSetsPassiveWaitsUnlessTheUserChose) {
   EXPECT_NE(waits("OMP_WAIT_POLICY=active", out + "_b").find("OMP_WAIT_POLICY=active"), std::string::npos);
   std::filesystem::remove_all(out + "_a");
   std::filesystem::remove_all(out + "_b");
+}
+
+// How many threads run the engine's loops (EngineParams::run_threads; engine/team_tuner.hpp)
+// changes speed, never a result: the work is split into `threads` parts summed in one order.
+// Tri-disc clusters with adhesion collide in a periodic box and pile onto a floor; with
+// threads = 3 the run on 1, 2 and 3 running threads and the measured choice (which probes 1 and
+// 3 after 200 steps and may switch) end bitwise alike.
+TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
+  auto run = [](int run_threads) {
+    EngineParams p;
+    Interaction ia;
+    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
+    ia.adhesion.hamaker_J = 1e-19;
+    ia.adhesion.min_separation_m = 4e-10;
+    ia.adhesion.cutoff_m = 5e-8;
+    p.interactions = {ia, ia};
+    p.dt = 2e-9;
+    p.skin = 5e-7;
+    p.gravity = {0, -1e4};
+    p.periodic_x = true;
+    p.x_lo = 0;
+    p.x_hi = 200e-6;
+    p.threads = 3;
+    p.run_threads = run_threads;
+    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    Rng rng(11);
+    for (int row = 0; row < 14; ++row)
+      for (int col = 0; col < 14; ++col) {
+        BodySpec s;
+        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+        s.radii = {3e-6, 3e-6, 2.5e-6};
+        s.density = 1700;
+        s.position = {14e-6 * col + 7e-6, 8e-6 + 14e-6 * row};
+        s.angle = rng.uniform(0, 6.28);
+        s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};  // collide, and pile onto the floor
+        s.omega = rng.uniform(-1e5, 1e5);
+        sim.add_body(s);
+      }
+    for (int k = 0; k < 2000; ++k) sim.step();
+    EXPECT_GT(sim.contacts(), 10);  // the run exercises contacts (21 open at the end; walls, adhesion)
+    return std::pair{sim.bodies().x, sim.bodies().y};
+  };
+  const auto one = run(1), two = run(2), all = run(3), measured = run(0);
+  ASSERT_EQ(one.first.size(), 196u);
+  EXPECT_TRUE(one == two);
+  EXPECT_TRUE(one == all);
+  EXPECT_TRUE(one == measured);
+}
+
+// The choice itself, on step times made up: the team whose median probe block is faster is
+// kept, and the next probe can switch back when the load changes.
+TEST(TeamTuner, KeepsTheFasterTeamAndProbesAgain) {
+  TeamTuner t(2);
+  ASSERT_TRUE(t.adaptive());
+  EXPECT_EQ(t.team(), 2);
+  auto run = [&](int steps, double t1, double t2) {  // step time with 1 and with 2 threads
+    for (int k = 0; k < steps; ++k) t.step_done(t.team() == 1 ? t1 : t2);
+  };
+  run(TeamTuner::kWarmupSteps, 1.0, 0.6);
+  // probe: 2 threads faster (a free core): kept
+  run(TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 0.6);
+  EXPECT_EQ(t.team(), 2);
+  EXPECT_EQ(t.probes(), 1);
+  // another job takes a core: 2 threads now slower (by less than the 1.5x that ends a probe
+  // early); the next probe, after a doubled hold, switches to 1
+  run(2 * TeamTuner::kHoldSteps + TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 1.3);
+  EXPECT_EQ(t.team(), 1);
+  EXPECT_EQ(t.switches(), 1);
+  EXPECT_EQ(t.probes(), 2);
+  // a probe of 2 threads on the taken core that is far slower ends after its first pair of blocks
+  run(TeamTuner::kHoldSteps + 2 * TeamTuner::kBlockSteps, 1.0, 3.0);
+  EXPECT_EQ(t.team(), 1);
+  EXPECT_EQ(t.probes(), 3);
+  // the core is free again: back to 2 at the next probe (the hold doubled again)
+  run(2 * TeamTuner::kHoldSteps + TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 0.6);
+  EXPECT_EQ(t.team(), 2);
+  EXPECT_EQ(t.switches(), 2);
+  // one slow block (a list rebuild) does not move the median
+  TeamTuner u(2);
+  int step = 0;
+  for (int k = 0; k < TeamTuner::kWarmupSteps + TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks; ++k, ++step)
+    u.step_done(u.team() == 1 ? 1.0 : (step == TeamTuner::kWarmupSteps + 5 ? 500.0 : 0.6));
+  EXPECT_EQ(u.team(), 2);
+  // fixed: no probing
+  TeamTuner f(2, 1);
+  EXPECT_FALSE(f.adaptive());
+  EXPECT_EQ(f.team(), 1);
 }

@@ -32,6 +32,8 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   require_positive("engine", "dt_s", params_.dt);
   require_positive("engine", "skin_m", params_.skin);
   if (params_.threads < 1) throw_input("engine", "threads", std::to_string(params_.threads), "must be >= 1");
+  if (params_.run_threads < 0 || params_.run_threads > params_.threads)
+    throw_input("engine", "run_threads", std::to_string(params_.run_threads), "must be 0 (adaptive) or 1..threads");
   if (params_.periodic_x && !(params_.x_hi > params_.x_lo))
     throw_input("engine", "periodic_x", "", "x_hi must exceed x_lo for a periodic box");
   for (auto& w : walls_) {
@@ -180,10 +182,19 @@ void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
   for (std::size_t b = b0; b < b1; ++b) place_body(b);
 }
 
+int Simulation::team() {
+  if (tuner_threads_ != params_.threads || tuner_fixed_ != params_.run_threads) {  // (params may be changed between steps)
+    tuner_threads_ = params_.threads;
+    tuner_fixed_ = params_.run_threads;
+    tuner_.reset(params_.threads, params_.run_threads);
+  }
+  return tuner_.team();
+}
+
 // moved: -1 = unknown (check every disc), 0/1 = the caller already checked (step() does it
 // in the drift loop).
 void Simulation::ensure_neighbor_list(int moved) {
-  nl_params_.threads = params_.threads;
+  nl_params_.threads = team();
   try {
     if (structure_changed_) {
       nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
@@ -223,7 +234,7 @@ void Simulation::build_wall_candidates() {
   }
   prepare_walls();
   const double skin = params_.skin;
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
+#pragma omp parallel for schedule(static) num_threads(team())
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t m = 0;
     for (std::size_t w = 0; w < nw; ++w)
@@ -391,7 +402,8 @@ void Simulation::contact_forces() {
       if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
   thread_nc_.assign(nt, 0);
   if (has_walls) thread_fail_.assign(nt, nullptr);
-#pragma omp parallel num_threads(nt)
+  const int run = team();  // threads that run the nt parts (results depend on nt only)
+#pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();
 #pragma omp for schedule(static)
@@ -404,8 +416,8 @@ void Simulation::contact_forces() {
     // (implicit barrier: every thread reads all packed discs)
     // Row chunk u (of nt) goes to thread u mod T: the same sums even if the runtime gave fewer
     // threads than asked for (OMP_DYNAMIC, OMP_THREAD_LIMIT, a nested region); one chunk each else.
-    const int team = omp_get_num_threads();
-    for (int u = t; u < nt; u += team) {
+    const int team_size = omp_get_num_threads();
+    for (int u = t; u < nt; u += team_size) {
       auto& buf = tforce_[u];
       const int lo = split_[u], hi = reach_hi_[u];
       std::fill(buf.begin() + lo, buf.begin() + hi, PackedForce{0.0, 0.0, 0.0, 0.0});
@@ -581,6 +593,7 @@ void Simulation::compute_forces() {
 }
 
 void Simulation::step() {
+  const double t_start = omp_get_wtime();
   if (!forces_valid_) {
     update_disc_positions(0, b_.x.size());
     compute_forces();
@@ -606,11 +619,11 @@ void Simulation::step() {
   const detail::DriftParams drift{dt, newmark, periodic, params_.x_lo, params_.x_hi};
   const int nt = params_.threads;
   thread_disp_.assign(2 * nt, 0.0);
-#pragma omp parallel num_threads(nt)
+#pragma omp parallel num_threads(team())
   {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
-  const std::size_t team = static_cast<std::size_t>(omp_get_num_threads());
-  const std::size_t b0 = nb * t / team, b1 = nb * (t + 1) / team;
+  const std::size_t team_size = static_cast<std::size_t>(omp_get_num_threads());
+  const std::size_t b0 = nb * t / team_size, b1 = nb * (t + 1) / team_size;
   detail::drift_bodies(drift, b0, b1, arrays);
   double d1 = 0.0, d2 = 0.0;
   for (std::size_t b = b0; b < b1; ++b) {
@@ -641,12 +654,13 @@ void Simulation::step() {
   provider_forces();
   forces_valid_ = true;
   if (!newmark) {
-#pragma omp parallel for schedule(static) num_threads(params_.threads)
+#pragma omp parallel for schedule(static) num_threads(team())
     for (std::size_t b = 0; b < nb; ++b) {
       const double h = 0.5 * dt;
       vx[b] += h * fx[b] * inv_m[b]; vy[b] += h * fy[b] * inv_m[b]; om[b] += h * tq[b] * inv_I[b];
     }
   }
+  tuner_.step_done(omp_get_wtime() - t_start);
 }
 
 Energy Simulation::energy() const {

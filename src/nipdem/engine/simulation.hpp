@@ -24,6 +24,7 @@
 
 #include "nipdem/core/particles.hpp"
 #include "nipdem/core/vec2.hpp"
+#include "nipdem/engine/team_tuner.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
 #include "nipdem/geometry/walls.hpp"
 #include "nipdem/models/contact.hpp"
@@ -66,6 +67,10 @@ struct EngineParams {
   bool periodic_x = false;                  // periodic box along x
   double x_lo = 0.0, x_hi = 0.0;            // its extent [m]
   int threads = 1;                          // OpenMP threads for the force loops
+  // How many of them run: 0 = chosen by measurement, all or 1, whichever runs the steps faster
+  // (another job may hold a core; engine/team_tuner.hpp), else that many (1..threads). The work is
+  // always split into `threads` parts summed in one order: the choice changes speed, not results.
+  int run_threads = 0;
 };
 
 // Shape and state of a body to add. Disc offsets are relative to any reference point; the
@@ -134,6 +139,8 @@ class Simulation {
   const std::vector<double>& provider_fy(std::size_t k) const { return prov_fy_[k]; }
   // Number of disc-disc and disc-wall contacts (overlap > 0) in the last evaluation.
   std::int64_t contacts() const { return n_contacts_; }
+  // The thread-count choice (EngineParams::run_threads): threads in use, probes and switches so far.
+  const TeamTuner& team_tuner() const { return tuner_; }
 
   Energy energy() const;
   // Serialises the complete dynamic state (bodies, discs, histories, walls, time).
@@ -199,6 +206,9 @@ class Simulation {
   std::int64_t step_ = 0;
   std::int64_t next_id_ = 0;
   std::int64_t n_contacts_ = 0;
+  TeamTuner tuner_;
+  int tuner_threads_ = 0, tuner_fixed_ = -1;  // the params the tuner was set up for
+  int team();                                 // threads to run the loops of this step with
   double pair_reach_ = 0.0;  // max adhesion cut-off of disc-disc interaction
 };
 

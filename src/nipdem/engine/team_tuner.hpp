@@ -1,0 +1,106 @@
+// How many threads run the engine's loops, chosen by measurement: on a machine shared with other
+// jobs a core may be taken, and then a step split over all threads waits for the slowest one
+// (2 threads on a core shared with another job ran at 0.6-0.9x of 1 thread, docs/performance.md).
+// The engine always splits its work into EngineParams::threads parts and sums them in the same
+// order, so the number of threads that run them changes the speed, never a result.
+//
+// Schedule: after a warm-up, alternate short blocks of steps with all threads and with one
+// (kProbeBlocks blocks of kBlockSteps each), keep the one whose median block time is lower, run
+// with it for kHoldSteps, and probe again (the load on a shared machine changes). A probe stops
+// after its first pair of blocks if the other team was more than 1.5x slower (a probe of two
+// threads on a taken core costs 2-3x the steps it runs), and each probe that confirms the choice
+// doubles the hold, up to kMaxHoldSteps: the probes cost ~1 % of the steps.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cstdint>
+
+namespace nipdem::engine {
+
+class TeamTuner {
+ public:
+  static constexpr int kWarmupSteps = 200;   // before the first probe (lists, caches settle)
+  static constexpr int kBlockSteps = 16;     // steps per probe block
+  static constexpr int kProbeBlocks = 8;     // blocks per probe, alternating (4 per candidate)
+  static constexpr int kHoldSteps = 4000;    // steps between probes (after a switch)
+  static constexpr int kMaxHoldSteps = 64000;
+
+  // max: the threads available (EngineParams::threads); fixed > 0: always use that many.
+  explicit TeamTuner(int max = 1, int fixed = 0) { reset(max, fixed); }
+  void reset(int max, int fixed) {
+    max_ = std::max(1, max);
+    fixed_ = fixed;
+    team_ = fixed > 0 ? std::min(fixed, max_) : max_;
+    chosen_ = max_;
+    until_probe_ = kWarmupSteps;
+    hold_ = kHoldSteps;
+    block_ = -1;
+  }
+  // Threads for the next step.
+  int team() const { return team_; }
+  // Whether the tuner is choosing (max > 1 and not fixed).
+  bool adaptive() const { return fixed_ <= 0 && max_ > 1; }
+  int switches() const { return switches_; }
+  int probes() const { return probes_; }
+
+  // Wall time [s] of the step just run with team().
+  void step_done(double seconds) {
+    if (!adaptive()) return;
+    if (block_ < 0) {  // holding
+      if (--until_probe_ > 0) return;
+      block_ = 0;
+      block_time_ = 0.0;
+      in_block_ = 0;
+      team_ = candidate(0);
+      return;
+    }
+    block_time_ += seconds;
+    if (++in_block_ < kBlockSteps) return;
+    times_[block_] = block_time_;
+    block_time_ = 0.0;
+    in_block_ = 0;
+    if (block_ == 1 && times_[1] > 1.5 * times_[0]) {  // the other team is clearly slower
+      end_probe(chosen_);
+      return;
+    }
+    if (++block_ < kProbeBlocks) {
+      team_ = candidate(block_);
+      return;
+    }
+    // even blocks ran candidate(0), odd ones candidate(1)
+    std::array<double, kProbeBlocks / 2> a{}, b{};
+    for (int k = 0; k < kProbeBlocks / 2; ++k) { a[k] = times_[2 * k]; b[k] = times_[2 * k + 1]; }
+    end_probe(median(a) <= median(b) ? candidate(0) : candidate(1));
+  }
+
+ private:
+  void end_probe(int best) {
+    if (best != chosen_) {
+      ++switches_;
+      hold_ = kHoldSteps;
+    } else {
+      hold_ = std::min(2 * hold_, kMaxHoldSteps);
+    }
+    chosen_ = best;
+    team_ = chosen_;
+    ++probes_;
+    block_ = -1;
+    until_probe_ = hold_;
+  }
+  // Probe blocks start with the team in use, then alternate with the other one (all or 1).
+  int candidate(int block) const {
+    const int other = chosen_ == 1 ? max_ : 1;
+    return block % 2 == 0 ? chosen_ : other;
+  }
+  template <std::size_t N> static double median(std::array<double, N> v) {
+    std::sort(v.begin(), v.end());
+    return N % 2 ? v[N / 2] : 0.5 * (v[N / 2 - 1] + v[N / 2]);
+  }
+  int max_ = 1, fixed_ = 0, team_ = 1, chosen_ = 1;
+  int until_probe_ = 0, hold_ = kHoldSteps, block_ = -1, in_block_ = 0;
+  double block_time_ = 0.0;
+  std::array<double, kProbeBlocks> times_{};
+  int switches_ = 0, probes_ = 0;
+};
+
+}  // namespace nipdem::engine
