@@ -81,14 +81,16 @@ TEST(ExperimentCli, TinyReductionRunReportsCountsAndSeries) {
 // all inserted - all removed, at the last sample), and a window that takes in toner while
 // letting none out is flagged "filling" with a warning instead of passing as a steady state.
 // The scenario is pinned to the pre-calibration adhesion and pits (r = 1, 0.1 nN, 15 um), where
-// this tiny window settles within 1 ms; the test is about the bookkeeping, not those values.
+// this tiny window settles within ~1 ms (1.2 ms allowed: at 1 ms the steadiness test is marginal,
+// 3.1 standard errors of drift against 3, and flips with the last bits of a run); the test is about
+// the bookkeeping, not those values.
 TEST(ExperimentCli, TinyFrontPositionReportsTheWindowsParticleBalance) {
   const fs::path d = fs::temp_directory_path() / ("nipdem_exp_front_" + std::to_string(::getpid()));
   fs::remove_all(d);
   const auto r = cli("experiment front-position --preset color --gap 100e-6 --set collision.stiffness_scale=0.01 "
                      "--set inflow.layer_thickness_m=15e-6 --set geometry.window_x_min_m=-200e-6 "
                      "--set geometry.window_x_max_m=200e-6 --set adhesion.cohesion_ratio=1 --set adhesion.roller_force_N=1e-10 "
-                     "--set geometry.roughness.height_m=15e-6 --min-time 8e-4 --max-time 1e-3 --quiet --json --out " + d.string());
+                     "--set geometry.roughness.height_m=15e-6 --min-time 8e-4 --max-time 1.2e-3 --quiet --json --out " + d.string());
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["points"].size(), 1u);
@@ -101,7 +103,7 @@ TEST(ExperimentCli, TinyFrontPositionReportsTheWindowsParticleBalance) {
   EXPECT_EQ(p["particles_at_end"].get<long>(), last[3].get<long>() - last[4].get<long>());  // conservation
   ASSERT_TRUE(p["steady"].get<bool>()) << p.dump();
   EXPECT_GT(p["inflow_steady"].get<long>(), 0);  // the drum keeps bringing toner
-  // 1 ms is far too short for the assembly to reach the window's end: nothing leaves but what
+  // ~1 ms is far too short for the assembly to reach the window's end: nothing leaves but what
   // the drum carries out at once, so the window is filling and says so
   EXPECT_LT(p["outflow_over_inflow_steady"].get<double>(), 0.5);
   EXPECT_TRUE(p["filling"].get<bool>());
