@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Issue 17 items 3-4: chapter 5 rerun on the calibrated presets (r = 1.8, F_adh = 10 nN, 7.1 um
 # cut; docs/reduction.md), plus the 12-line edge study of the softening. Two lanes, one core each,
-# so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b: done; black | color: the chosen softening)
+# so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b: done; black | color: the chosen softening;
+# why: the colour Vo, one change at a time)
 # Resumable: every experiment resumes its realizations from its --out folder, and a step whose
 # JSON exists is skipped. A step's wall time goes to walltimes.txt.
 set -euo pipefail
@@ -69,5 +70,19 @@ color) front_and_vo color 0.5e-3
   step size/color_6_9_12_k$K $edge_color --realizations 50 --set collision.stiffness_scale=$K \
     --set toner.d_small_m=6e-6 --set toner.d50_m=9e-6 --set toner.d_large_m=12e-6
   ;;
-*) echo "usage: run.sh a|b|black|color [NIPDEM_BINARY]" >&2; exit 2 ;;
+why)
+  # Why the colour Vo fell from 21.8 V (old presets) to 5.8 V (calibrated, 0.01): the four things
+  # that changed, one at a time, each reverted on the calibrated preset at 0.01 (vo/color is the
+  # reference). a: roller adhesion 10 -> 0.1 nN with the cohesion force kept at 18 nN (r = 180);
+  # b: cohesion 18 -> 0.1 nN (r = 0.01) with the roller adhesion kept; c: pit cut 7.1 -> 15 um;
+  # d: the old, swapped radii (drum 0.02 m, roller 0.05 m).
+  vo_color="experiment vo-level --config $ex/print_line_color.toml --set inflow.prefill=false --v0 0 \
+    --coarse-step 5 --step 0.5 --vmax 40 --seeds 3 --line-start 0.5e-3 --line-length 0.15e-3 --extra-time 1e-3 \
+    --set collision.stiffness_scale=0.01"
+  step vo/why_color_a_roller_adhesion $vo_color --set adhesion.roller_force_N=1e-10 --set adhesion.cohesion_ratio=180
+  step vo/why_color_b_cohesion $vo_color --set adhesion.cohesion_ratio=0.01
+  step vo/why_color_c_pit_cut $vo_color --set geometry.roughness.height_m=15e-6
+  step vo/why_color_d_radii $vo_color --set geometry.drum_radius_m=0.02 --set geometry.roller_radius_m=0.05
+  ;;
+*) echo "usage: run.sh a|b|black|color|why [NIPDEM_BINARY]" >&2; exit 2 ;;
 esac
