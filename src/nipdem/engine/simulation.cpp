@@ -308,6 +308,17 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   const int* nb = nlist_.nbr_.data();
   double* eta = nlist_.eta_.data();
   std::uint8_t* sl = nlist_.slide_.data();
+  const int* own = entry_row_.data();
+  // i - j centre vector, the minimum image if periodic (|dx| < 1.5 L since centres are wrapped)
+  auto separation = [&](const PackedDisc& pi, const PackedDisc& pj) __attribute__((always_inline)) {
+    double dx = pi.x - pj.x;
+    const double dy = pi.y - pj.y;
+    if constexpr (kPeriodic) {
+      dx = dx > hL ? dx - L : dx;
+      dx = dx < -hL ? dx + L : dx;
+    }
+    return Vec2{dx, dy};
+  };
   detail::PairBatch batch;
   detail::PairBatch& B = batch;
   int n = 0;
@@ -323,7 +334,9 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   };
   auto flush = [&]() __attribute__((always_inline)) {
     for (int k = 0; k < n; ++k) {  // gather what the law reads
-      const int i = B.i[k], j = B.j[k], e = B.e[k];
+      const int e = B.e[k], i = own[e], j = nb[e];
+      const Vec2 d = separation(P[i], P[j]);
+      B.dx[k] = d.x; B.dy[k] = d.y; B.i[k] = i; B.j[k] = j;
       B.ri[k] = P[i].r; B.rj[k] = P[j].r; B.mi[k] = P[i].m; B.mj[k] = P[j].m;
       B.vix[k] = V[i].vx; B.viy[k] = V[i].vy; B.wi[k] = V[i].w;
       B.vjx[k] = V[j].vx; B.vjy[k] = V[j].vy; B.wj[k] = V[j].w;
@@ -347,22 +360,17 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   };
   // One flat loop over the rows' entries, without a branch on the data: the test's outcome
   // (about one entry in three interacts in a packing) and the row lengths (0-6) are what a
-  // branch predictor cannot learn. An entry is always written to the batch; the count moves
-  // on only if the pair interacts.
-  const int* own = entry_row_.data();
+  // branch predictor cannot learn. The entry is always written to the batch; the count moves
+  // on only if the pair interacts. Only the entry is kept: the pair's data are read again in
+  // flush() for the few that interact (in the nip the list reaches the adhesion cut-off plus the
+  // skin, and most listed pairs are apart).
   for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) {
-    const int i = own[e], j = nb[e];
-    const PackedDisc& pi = P[i];
-    const PackedDisc& pj = P[j];
-    double dx = pi.x - pj.x;
-    const double dy = pi.y - pj.y;
-    if constexpr (kPeriodic) {  // minimum image; |dx| < 1.5 L since centres are wrapped
-      dx = dx > hL ? dx - L : dx;
-      dx = dx < -hL ? dx + L : dx;
-    }
+    const PackedDisc& pi = P[own[e]];
+    const PackedDisc& pj = P[nb[e]];
+    const Vec2 d = separation(pi, pj);
     const double rc = (pi.r + pj.r) + reach;
-    const bool interacts = dx * dx + dy * dy < rc * rc;
-    B.dx[n] = dx; B.dy[n] = dy; B.e[n] = e; B.i[n] = i; B.j[n] = j;
+    const bool interacts = d.x * d.x + d.y * d.y < rc * rc;
+    B.e[n] = e;
     n += interacts ? 1 : 0;
     // History of a pair out of range is reset where there is some (rare: a contact that just
     // opened); most stay clean, and a read keeps their cache lines clean (no write-back).
