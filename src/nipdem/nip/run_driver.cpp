@@ -210,6 +210,10 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
       {"integrator", cfg.integrator == engine::Integrator::velocity_verlet ? "velocity_verlet" : "newmark_explicit"},
       {"threads", cfg.threads},
       {"omp_waits", wait_policy()},  // how OpenMP threads waited (core/wait_policy.hpp)
+      // how many of them ran the engine's steps at the end (measured choice, engine/team_tuner.hpp;
+      // speed only: results do not depend on it) and how often the choice changed
+      {"threads_running", run.sim().team_tuner().team()},
+      {"thread_choice_switches", run.sim().team_tuner().switches()},
       {"particles_in_window", run.sim().bodies().x.size()},
       {"discs_in_window", run.sim().discs().x.size()},
       {"inserted", run.inserted()},
