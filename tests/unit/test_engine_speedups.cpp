@@ -277,3 +277,19 @@ TEST(TeamTuner, KeepsTheFasterTeamAndProbesAgain) {
   EXPECT_FALSE(f.adaptive());
   EXPECT_EQ(f.team(), 1);
 }
+
+// run_threads outside 0..threads is refused when the engine is made, naming the key.
+TEST(TeamTuner, RunThreadsOutsideItsRangeIsRefused) {
+  for (const int bad : {-1, 3}) {
+    EngineParams p;
+    p.interactions = {Interaction{}};
+    p.threads = 2;
+    p.run_threads = bad;
+    try {
+      Simulation sim(p, {});
+      ADD_FAILURE() << "run_threads = " << bad << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find("run_threads"), std::string::npos) << e.what();
+    }
+  }
+}
