@@ -586,6 +586,7 @@ void Simulation::provider_forces() {
     std::fill(prov_fx_[k].begin(), prov_fx_[k].end(), 0.0);
     std::fill(prov_fy_[k].begin(), prov_fy_[k].end(), 0.0);
     std::fill(prov_tq_[k].begin(), prov_tq_[k].end(), 0.0);
+    forces_[k]->set_running_threads(team());
     forces_[k]->add(b_, d_, time_, prov_fx_[k], prov_fy_[k], prov_tq_[k]);
     for (std::size_t b = 0; b < nb; ++b) {
       b_.fx[b] += prov_fx_[k][b]; b_.fy[b] += prov_fy_[k][b]; b_.torque[b] += prov_tq_[k][b];

@@ -56,6 +56,15 @@ class BodyForce {
   // with the engine's checkpoint so that a resumed run is bitwise identical.
   virtual void save(std::ostream&) const {}
   virtual void load(std::istream&) {}
+  // Threads the engine runs its own loops with in this evaluation (its measured choice,
+  // EngineParams::run_threads), set before add(); 0 if add() is called from elsewhere. A
+  // provider that splits its work into a fixed number of parts may run them on this many
+  // threads, so that it gives way on a contended machine as the engine does, with the same results.
+  int running_threads() const { return running_threads_; }
+  void set_running_threads(int n) { running_threads_ = n; }
+
+ private:
+  int running_threads_ = 0;
 };
 
 struct EngineParams {

@@ -198,7 +198,7 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
 }
 
 void PairSum::compute(std::span<const double> x, std::span<const double> y, std::span<const Vec2> m, bool same_set,
-                      std::vector<double>& fx, std::vector<double>& fy) {
+                      std::vector<double>& fx, std::vector<double>& fy, int run_threads) {
   const std::size_t n = x.size();
   fx.assign(n, 0.0);
   fy.assign(n, 0.0);
@@ -215,10 +215,11 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
   const Packed* pk = pk_.data();
   const int* rs = row_start_.data();
   const int* nb = nbr_.data();
-#pragma omp parallel num_threads(nt)
+  const int run = run_threads > 0 ? std::min(run_threads, nt) : nt;
+#pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();
-    // Row chunk u (of nt) goes to thread u mod T: the same sums if the runtime gave fewer threads.
+    // Row chunk u (of nt) goes to thread u mod T: the same sums if fewer threads run them.
     const int team = omp_get_num_threads();
     for (int u = t; u < nt; u += team) {
       double* f = buf_[static_cast<std::size_t>(u)].data();

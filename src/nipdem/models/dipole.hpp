@@ -60,9 +60,10 @@ class PairSum {
  public:
   explicit PairSum(PairSumParams p = {});
   // Forces on every particle into fx, fy (resized to n). same_set = false when the particles
-  // or their order changed since the last call (forces a rebuild).
+  // or their order changed since the last call (forces a rebuild). run_threads (1..threads;
+  // 0 = threads) runs the `threads` parts on fewer threads, with the same sums.
   void compute(std::span<const double> x, std::span<const double> y, std::span<const Vec2> m, bool same_set,
-               std::vector<double>& fx, std::vector<double>& fy);
+               std::vector<double>& fx, std::vector<double>& fy, int run_threads = 0);
   void invalidate() { built_n_ = -1; }  // the next compute() rebuilds the list
   const PairSumParams& params() const { return p_; }
   int builds() const { return builds_; }

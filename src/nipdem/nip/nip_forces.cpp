@@ -136,7 +136,8 @@ void MagnetForce::field_pass(const BodyStore& b) {
   // index rethrown after the loop, so any thread count reports the same error as one thread.
   std::size_t first_bad = n;
   std::exception_ptr error;
-#pragma omp parallel for schedule(static) num_threads(nt)
+  const int run = running_threads() > 0 ? std::min(running_threads(), nt) : nt;  // the engine's choice (same results)
+#pragma omp parallel for schedule(static) num_threads(run)
   for (std::size_t i = 0; i < n; ++i) {
     try {
       const Vec2 p{b.x[i], b.y[i]};
@@ -158,7 +159,7 @@ void MagnetForce::field_pass(const BodyStore& b) {
 // or a body moved more than skin/2) and sums each pair once. The result equals the plain
 // cut-off sum (tested against an O(N^2) sum) and does not depend on when the list was built.
 void MagnetForce::dipole_pass(const BodyStore& b, bool same_set) {
-  pairs_.compute(b.x, b.y, moment_, same_set, dfx_, dfy_);
+  pairs_.compute(b.x, b.y, moment_, same_set, dfx_, dfy_, running_threads());
 }
 
 ElectricForce::ElectricForce(const engine::Simulation* sim, ElectricConfig cfg) : sim_(sim), cfg_(std::move(cfg)) {
