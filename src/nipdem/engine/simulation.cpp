@@ -319,8 +319,7 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     }
     return Vec2{dx, dy};
   };
-  detail::PairBatch batch;
-  detail::PairBatch& B = batch;
+  detail::PairBatch B;
   int n = 0;
   std::int64_t nc = 0;
   // the row whose own sum is open, and that sum
@@ -623,7 +622,7 @@ void Simulation::step() {
   // large rotations, then placing the discs and tracking the two largest disc displacements
   // since the list was built.
   dtheta_.resize(nb);
-  const detail::BodyArrays arrays{x, y, vx, vy, b_.theta.data(), b_.omega.data(), b_.cth.data(), b_.sth.data(),
+  const detail::BodyArrays arrays{x, y, vx, vy, b_.theta.data(), om, b_.cth.data(), b_.sth.data(),
                                   fx, fy, tq, b_.mass.data(), b_.inertia.data(), inv_m, inv_I, dtheta_.data()};
   const detail::DriftParams drift{dt, newmark, periodic, params_.x_lo, params_.x_hi};
   const int nt = params_.threads;
