@@ -9,7 +9,9 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/experiments/ensemble.hpp"
+#include "nipdem/experiments/experiment.hpp"
 #include "nipdem/io/atomic_file.hpp"
+#include "nipdem/version.hpp"
 
 using namespace nipdem;
 namespace fs = std::filesystem;
@@ -92,6 +94,48 @@ TEST(AnalysisEnsemble, ResumeSkipsFinishedRealizations) {
   o.seed = 4;
   EXPECT_THROW(ensemble::run(task, o), InputError);
   fs::remove_all(dir);
+}
+
+// A study resumed by another build mixes builds; each realization file says which computed it,
+// and a record written before the key existed reads back as "" (reported as "unrecorded").
+TEST(AnalysisEnsemble, EachRealizationRecordsTheBuildThatComputedIt) {
+  const fs::path dir = fresh_dir("builds");
+  ensemble::Options o;
+  o.count = 4;
+  o.seed = 9;
+  o.dir = dir;
+  ensemble::run(walk, o);
+  // Realization 2 as an older build wrote it (no git_hash), realization 3 from another build.
+  auto rewrite = [&](std::size_t i, const char* hash) {
+    const fs::path f = ensemble::realization_path(dir, i);
+    auto j = nlohmann::json::parse(io::read_file(f));
+    EXPECT_EQ(j.at("git_hash").get<std::string>(), kGitHash);
+    if (hash) j["git_hash"] = hash;
+    else j.erase("git_hash");
+    io::write_file_atomic(f, j.dump());
+  };
+  rewrite(2, nullptr);
+  rewrite(3, "0123456789ab");
+  fs::remove(ensemble::realization_path(dir, 0));
+  const auto s = ensemble::run(walk, o);
+  ASSERT_EQ(s.records.size(), 4u);
+  EXPECT_EQ(s.records[0].git_hash, kGitHash);  // recomputed now
+  EXPECT_EQ(s.records[1].git_hash, kGitHash);  // resumed, from this build
+  EXPECT_EQ(s.records[2].git_hash, "");
+  EXPECT_EQ(s.records[3].git_hash, "0123456789ab");
+  fs::remove_all(dir);
+}
+
+TEST(AnalysisEnsemble, MetaCountsTheRealizationsOfEachBuild) {
+  ensemble::Summary s;
+  for (const char* h : {"aaa", "", "aaa", "bbb"}) {
+    s.records.emplace_back();
+    s.records.back().git_hash = h;
+  }
+  const auto m = experiments::meta(experiments::ExperimentOptions{}, &s);
+  EXPECT_EQ(m.at("realization_builds"), (nlohmann::json{{"aaa", 2}, {"bbb", 1}, {"unrecorded", 1}}));
+  EXPECT_EQ(m.at("git_hash").get<std::string>(), kGitHash);
+  EXPECT_FALSE(experiments::meta(experiments::ExperimentOptions{}).contains("realization_builds"));
 }
 
 TEST(AnalysisEnsemble, FailedRealizationIsRecordedReportedAndRetried) {

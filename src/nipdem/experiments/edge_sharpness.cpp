@@ -105,7 +105,7 @@ json edge_sharpness(const ExperimentOptions& o, const EdgeOptions& e) {
   const auto curves = coverage_curves(o, sum, g, printed_total);
   write_lines_csv(o.out / "lines.csv", sum);
   json out = {{"experiment", "edge-sharpness"}, {"voltage_V", volts}, {"realizations", curves.size()}, {"printed_particles", printed_total},
-              {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"lines_file", (o.out / "lines.csv").string()}, {"meta", meta(o)}};
+              {"failed", failures(sum)}, {"n_failed", sum.n_failed}, {"lines_file", (o.out / "lines.csv").string()}, {"meta", meta(o, &sum)}};
   const auto avg = curves.empty() ? std::vector<double>(g.n, 0.0) : analysis::average_curve(curves);
   double peak = 0;
   for (double c : avg) peak = std::max(peak, c);

@@ -10,6 +10,7 @@
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
+#include "nipdem/version.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 #ifdef NIPDEM_HAVE_MPI
@@ -30,6 +31,7 @@ fs::path realization_path(const fs::path& dir, std::size_t index) {
 
 nlohmann::json to_json(const Record& r) {
   nlohmann::json j{{"index", r.index}, {"seed", r.seed}, {"ok", r.ok}, {"wall_s", r.wall_s}, {"rank", r.rank}};
+  if (!r.git_hash.empty()) j["git_hash"] = r.git_hash;
   if (r.ok) j["result"] = r.result;
   else j["error"] = r.error;
   return j;
@@ -42,6 +44,7 @@ Record record_from_json(const nlohmann::json& j) {
   r.ok = j.at("ok").get<bool>();
   r.wall_s = j.value("wall_s", 0.0);
   r.rank = j.value("rank", 0);
+  r.git_hash = j.value("git_hash", std::string());
   if (r.ok) r.result = j.at("result");
   else r.error = j.value("error", std::string("unknown error"));
   return r;
@@ -184,6 +187,7 @@ Summary run(const Task& task, const Options& opts) {
         r.error = "unknown exception (not derived from std::exception)";
       }
       r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      r.git_hash = kGitHash;  // a resumed study may mix builds: each realization says which ran it
       if (!opts.dir.empty()) {
         try {
           io::write_file_atomic(realization_path(opts.dir, r.index), to_json(r).dump(1) + "\n");

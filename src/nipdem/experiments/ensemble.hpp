@@ -55,6 +55,7 @@ struct Record {
   std::string error;              // what() when failed
   double wall_s = 0;              // wall time of the computation
   int rank = 0;                   // MPI rank that computed it (0 without MPI)
+  std::string git_hash;           // build that computed it ("" in records written before it was kept)
 };
 
 struct Summary {

@@ -95,9 +95,18 @@ json failures(const ensemble::Summary& s) {
   return f;
 }
 
-json meta(const ExperimentOptions& o) {
-  return {{"git_hash", kGitHash}, {"preset", o.config.empty() ? o.preset : ""}, {"config", o.config}, {"set", o.sets},
-          {"seed", o.seed}, {"jobs", o.jobs}, {"mpi", o.mpi}};
+json meta(const ExperimentOptions& o, const ensemble::Summary* sum) {
+  json m{{"git_hash", kGitHash}, {"preset", o.config.empty() ? o.preset : ""}, {"config", o.config}, {"set", o.sets},
+         {"seed", o.seed}, {"jobs", o.jobs}, {"mpi", o.mpi}};
+  if (sum) {
+    json builds = json::object();
+    for (const auto& r : sum->records) {
+      const std::string h = r.git_hash.empty() ? "unrecorded" : r.git_hash;
+      builds[h] = builds.value(h, 0) + 1;
+    }
+    m["realization_builds"] = builds;
+  }
+  return m;
 }
 
 }  // namespace nipdem::experiments

@@ -163,7 +163,7 @@ json front_position(const ExperimentOptions& o, const FrontPositionOptions& f) {
   json rows = report(o, sum, n_filling);
   return {{"experiment", "front-position"}, {"points", rows}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
           {"n_filling", n_filling},
-          {"csv", (o.out / "front_position.csv").string()}, {"plot", (o.out / "front_position.png").string()}, {"meta", meta(o)}};
+          {"csv", (o.out / "front_position.csv").string()}, {"plot", (o.out / "front_position.png").string()}, {"meta", meta(o, &sum)}};
 }
 
 }  // namespace nipdem::experiments

@@ -154,7 +154,7 @@ json reduction(const ExperimentOptions& o, const ReductionOptions& r) {
   return {{"experiment", "reduction"}, {"pits", r.pits}, {"points", rows},
           {"pile_width_m", r.pile_width_m}, {"pile_height_m", r.pile_height_m}, {"pile_area_fraction", r.pile_area_fraction}, {"failed", failures(sum)}, {"n_failed", sum.n_failed},
           {"table_4_3_reduction_speed_m_per_s", {{"black", 7.6e-4}, {"color", 2.5e-4}}},
-          {"csv", (o.out / "reduction.csv").string()}, {"meta", meta(o)}};
+          {"csv", (o.out / "reduction.csv").string()}, {"meta", meta(o, &sum)}};
 }
 
 }  // namespace nipdem::experiments

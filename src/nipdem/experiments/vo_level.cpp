@@ -56,7 +56,7 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   if (vo.size() > 1) sd = std::sqrt(sd / (vo.size() - 1));
   return {{"experiment", "vo-level"}, {"step_V", v.step_V}, {"coarse_step_V", v.coarse_step_V}, {"vo_mean_V", vo.empty() ? json(nullptr) : json(mean)}, {"vo_std_V", sd},
           {"seeds_found", vo.size()}, {"seeds_total", v.seeds}, {"per_seed", per}, {"failed", failures(sum)},
-          {"n_failed", sum.n_failed}, {"meta", meta(o)}};
+          {"n_failed", sum.n_failed}, {"meta", meta(o, &sum)}};
 }
 
 }  // namespace nipdem::experiments
