@@ -373,7 +373,7 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     n += interacts ? 1 : 0;
     // History of a pair out of range is reset where there is some (rare: a contact that just
     // opened); most stay clean, and a read keeps their cache lines clean (no write-back).
-    if (!interacts & ((sl[e] != 0) | (eta[e] != 0.0))) { eta[e] = 0.0; sl[e] = 0; }
+    if ((!interacts) & ((sl[e] != 0) | (eta[e] != 0.0))) { eta[e] = 0.0; sl[e] = 0; }
     if (n == detail::PairBatch::kN) flush();
   }
   flush();

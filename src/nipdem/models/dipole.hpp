@@ -82,6 +82,10 @@ class PairSum {
   std::vector<std::vector<double>> buf_;   // per-thread force buffers (fx, fy interleaved)
   std::vector<int> head_, next_;           // cell-list scratch
   std::vector<int> cand_;
+  int max_row_ = 0;                        // longest row of the list
+  // Per part: one row's partners within r_c (separation, moment, index) and their forces
+  struct RowScratch { std::vector<double> dx, dy, mx, my, gx, gy; std::vector<int> j; };
+  std::vector<RowScratch> rows_;
 };
 
 // The same sum by testing all N(N-1)/2 pairs (reference for tests).
