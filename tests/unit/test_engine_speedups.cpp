@@ -16,6 +16,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <nlohmann/json.hpp>
 
 #include "../cli_run.hpp"
 #include "support/engine_fixtures.hpp"
@@ -189,6 +190,25 @@ TEST(WaitPolicy, TheCliSetsPassiveWaitsUnlessTheUserChose) {
   EXPECT_NE(waits("OMP_WAIT_POLICY=active", out + "_b").find("OMP_WAIT_POLICY=active"), std::string::npos);
   std::filesystem::remove_all(out + "_a");
   std::filesystem::remove_all(out + "_b");
+}
+
+// summary.json counts the builds of the contact and dipole pair lists (what the skins trade
+// against); the black example has dipole-dipole forces on, so both lists are built at least
+// once, and at most once per step.
+TEST(RunSummary, CountsThePairListBuilds) {
+  const std::string out = "/tmp/nipdem_listbuilds_" + std::to_string(::getpid());
+  const auto r = nipdem::test::run_cli_command(std::string(NIPDEM_CLI_PATH) + " run " + NIPDEM_SOURCE_DIR +
+                                                   "/examples/nip_black_small.toml --set run.end_time_s=2e-6 --force --out " + out,
+                                               "listbuilds");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream f(out + "/summary.json");
+  const auto j = nlohmann::json::parse(f);
+  const long steps = j.at("steps").get<long>();
+  for (const char* k : {"neighbor_list_builds", "dipole_list_builds"}) {
+    EXPECT_GE(j.at(k).get<long>(), 1) << k;
+    EXPECT_LE(j.at(k).get<long>(), steps) << k;
+  }
+  std::filesystem::remove_all(out);
 }
 
 // How many threads run the engine's loops (EngineParams::run_threads; engine/team_tuner.hpp)

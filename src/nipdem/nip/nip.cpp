@@ -68,7 +68,8 @@ NipRun::NipRun(NipConfig cfg) : cfg_(std::move(cfg)), ts_(choose_time_step(cfg_)
   if (auto field = make_magnet_field(cfg_.magnet)) {
     // the field must be valid wherever a toner centre can go (refused at setup, not mid-run)
     check_field_region(*field, reachable_region(cfg_), fmt::format("{} (magnet.field = \"{}\")", cfg_.file.empty() ? "config" : cfg_.file, cfg_.magnet.field));
-    sim_->add_force(std::make_shared<MagnetForce>(field, cfg_.magnet));
+    magnet_ = std::make_shared<MagnetForce>(field, cfg_.magnet);
+    sim_->add_force(magnet_);
   }
   if (cfg_.electric.enabled) {
     electric_ = std::make_shared<ElectricForce>(sim_.get(), cfg_.electric);

@@ -65,6 +65,7 @@ class NipRun {
   const std::vector<RemovalEvent>& removals() const { return removals_; }
   // The electric force provider (null unless [electric] enabled).
   const ElectricForce* electric() const { return electric_.get(); }
+  const MagnetForce* magnet() const { return magnet_.get(); }  // nullptr without a magnet
   // Position on the drum surface (arc length, s = 0 at the nip at t = 0, increasing with the
   // drum's travel) of a particle that left on the drum at time t and position x: the print
   // pattern's coordinate (§2.5.1).
@@ -122,6 +123,7 @@ class NipRun {
   std::vector<RemovalEvent> removals_;
   const ClusterTemplate* tmpl_ = nullptr;
   std::shared_ptr<ElectricForce> electric_;
+  std::shared_ptr<MagnetForce> magnet_;
 };
 
 // Where a toner centre can go in the nip `c` describes (the window, from the roller surface less
