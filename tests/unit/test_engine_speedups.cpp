@@ -204,7 +204,7 @@ TEST(RunSummary, CountsThePairListBuilds) {
   std::ifstream f(out + "/summary.json");
   const auto j = nlohmann::json::parse(f);
   const long steps = j.at("steps").get<long>();
-  for (const char* k : {"neighbor_list_builds", "dipole_list_builds"}) {
+  for (const char* k : {"neighbor_list_builds_this_session", "dipole_list_builds_this_session"}) {
     EXPECT_GE(j.at(k).get<long>(), 1) << k;
     EXPECT_LE(j.at(k).get<long>(), steps) << k;
   }

@@ -133,7 +133,11 @@ TEST(AnalysisEnsemble, MetaCountsTheRealizationsOfEachBuild) {
     s.records.back().git_hash = h;
   }
   const auto m = experiments::meta(experiments::ExperimentOptions{}, &s);
-  EXPECT_EQ(m.at("realization_builds"), (nlohmann::json{{"aaa", 2}, {"bbb", 1}, {"unrecorded", 1}}));
+  const auto b = m.at("realization_builds");
+  ASSERT_EQ(b.size(), 3u);
+  EXPECT_EQ(b[0], (nlohmann::json{{"git_hash", "aaa"}, {"realizations", 2}}));
+  EXPECT_EQ(b[1], (nlohmann::json{{"git_hash", "unrecorded"}, {"realizations", 1}}));
+  EXPECT_EQ(b[2], (nlohmann::json{{"git_hash", "bbb"}, {"realizations", 1}}));
   EXPECT_EQ(m.at("git_hash").get<std::string>(), kGitHash);
   EXPECT_FALSE(experiments::meta(experiments::ExperimentOptions{}).contains("realization_builds"));
 }

@@ -1,5 +1,7 @@
 #include "nipdem/experiments/experiment.hpp"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <sstream>
 
@@ -98,11 +100,13 @@ json failures(const ensemble::Summary& s) {
 json meta(const ExperimentOptions& o, const ensemble::Summary* sum) {
   json m{{"git_hash", kGitHash}, {"preset", o.config.empty() ? o.preset : ""}, {"config", o.config}, {"set", o.sets},
          {"seed", o.seed}, {"jobs", o.jobs}, {"mpi", o.mpi}};
-  if (sum) {
-    json builds = json::object();
+  if (sum) {  // [{git_hash, realizations}] in order of first appearance
+    json builds = json::array();
     for (const auto& r : sum->records) {
       const std::string h = r.git_hash.empty() ? "unrecorded" : r.git_hash;
-      builds[h] = builds.value(h, 0) + 1;
+      auto it = std::find_if(builds.begin(), builds.end(), [&](const json& b) { return b["git_hash"] == h; });
+      if (it == builds.end()) builds.push_back({{"git_hash", h}, {"realizations", 1}});
+      else (*it)["realizations"] = (*it)["realizations"].get<int>() + 1;
     }
     m["realization_builds"] = builds;
   }

@@ -66,7 +66,8 @@ io::Progress run_progress(const ExperimentOptions& o, const std::string& label, 
 nlohmann::json failures(const ensemble::Summary& s);
 // The "meta" block of an experiment's JSON (CLI.md).
 // What ran: build, preset/config, overrides, seed, jobs; with the ensemble, also how many of its
-// realizations each build computed ("realization_builds"; "unrecorded" for records older than that key).
+// realizations each build computed ("realization_builds": [{git_hash, realizations}]; git_hash
+// "unrecorded" for records older than that key).
 nlohmann::json meta(const ExperimentOptions& o, const ensemble::Summary* sum = nullptr);
 
 }  // namespace nipdem::experiments

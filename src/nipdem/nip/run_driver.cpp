@@ -214,10 +214,10 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
       // speed only: results do not depend on it) and how often the choice changed
       {"threads_running", run.sim().team_tuner().team()},
       {"thread_choice_switches", run.sim().team_tuner().switches()},
-      // how often the contact and the dipole pair lists were built (speed only: run.neighbor_skin_d50,
+      // how often this session (this process) built the contact and dipole pair lists (speed only: run.neighbor_skin_d50,
       // magnet.dipole_skin_m; a change of the body set at an exchange rebuilds both)
-      {"neighbor_list_builds", run.sim().neighbor_list().builds()},
-      {"dipole_list_builds", run.magnet() ? run.magnet()->dipole_pairs().builds() : 0},
+      {"neighbor_list_builds_this_session", run.sim().neighbor_list().builds()},
+      {"dipole_list_builds_this_session", run.magnet() ? run.magnet()->dipole_pairs().builds() : 0},
       {"particles_in_window", run.sim().bodies().x.size()},
       {"discs_in_window", run.sim().discs().x.size()},
       {"inserted", run.inserted()},
