@@ -1,5 +1,6 @@
-// Rough-cylinder queries: the prepared fast path (one sin/cos per query, rotations for the
-// rest) must find the same features as direct trigonometry per vertex.
+// Rough-cylinder queries: the prepared fast path (one sin/cos per query; the disc centre turned
+// into the period's own frame, where the profile's vertices and segments are prepared constants)
+// must find the same features as direct trigonometry per vertex.
 #include <gtest/gtest.h>
 
 #include <algorithm>

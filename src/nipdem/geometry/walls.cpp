@@ -75,20 +75,17 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       need_next = P - s_in <= w;
     }
   }
-  // World positions of one period's profile vertices, computed once per period and shared
-  // by its segments and vertices. Scratch grows once per thread.
-  thread_local std::vector<Vec2> pts;
-  if (pts.size() < profile.size()) pts.resize(profile.size());
   const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P &&
                     prepared_phase_ == phase && static_cast<int>(period_units_.size()) == n_periods;
   const bool fast_angle = fast && prepared_angle_ == angle;
-  for (int dk = -1; dk <= 1; ++dk) {
-    if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
-    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
-    if (fast) {
-      // (cos, sin) of the polar angle of period k's s = 0: the roller-frame table rotated by
-      // the roller's angle (no trigonometry when prepare_angle() saw this angle).
-      Vec2 u;
+  const double lim = r + reach;
+  if (fast && prepared_profile_ == profile) {
+    // In the period's own frame: the centre is turned by the period's angle once, the vertices
+    // and segments are constants (prepare()); a hit is turned back into the world.
+    for (int dk = -1; dk <= 1; ++dk) {
+      if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
+      const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+      Vec2 u;  // (cos, sin) of the polar angle of period k's s = 0 (no trigonometry when prepare_angle() saw this angle)
       if (fast_angle) {
         const Vec2 q = period_units_[k], a = angle_rotation_;
         u = {a.x * q.x - a.y * q.y, a.x * q.y + a.y * q.x};
@@ -96,40 +93,66 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
         const double base = (k * P + phase) / radius + angle;
         u = {std::cos(base), std::sin(base)};
       }
-      for (int j = 0; j <= m; ++j) {
-        const Vec2 e{u.x * unit_offsets_[j].x - u.y * unit_offsets_[j].y, u.x * unit_offsets_[j].y + u.y * unit_offsets_[j].x};
-        pts[j] = centre + (radius - profile[j].y) * e;
+      const Vec2 cl{u.x * d.x + u.y * d.y, u.x * d.y - u.y * d.x};  // d turned by -angle(u)
+      auto to_world = [&](Vec2 v) { return Vec2{u.x * v.x - u.y * v.y, u.x * v.y + u.y * v.x}; };
+      for (int j = 0; j < m; ++j) {
+        const Vec2 a = local_vertex_[j], ab = local_edge_[j];
+        const double t = dot(cl - a, ab) * local_inv_len2_[j];
+        // Interior contacts only; convex vertices are handled below, concave vertices are
+        // covered by the interiors of their two faces.
+        if (!(t > 0.0 && t < 1.0)) continue;
+        const Vec2 dq = cl - (a + t * ab);
+        const double dd2 = norm2(dq);
+        if (dd2 > lim * lim || dd2 <= 0.0) continue;  // cheap reject before the square root
+        const double dd = std::sqrt(dd2);
+        const double gap = dd - r;
+        if (gap > reach) continue;
+        const Vec2 q = centre + to_world(a + t * ab);
+        hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, to_world(dq / dd), gap, cross(omega, q - centre)});
       }
-    } else {
-      for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
+      for (int j = 0; j < m; ++j) {
+        if (!convex_[j]) continue;
+        const Vec2 dq = cl - local_vertex_[j];
+        const double dd2 = norm2(dq);
+        if (dd2 > lim * lim || dd2 <= 0.0) continue;
+        const double dd = std::sqrt(dd2);
+        const double gap = dd - r;
+        if (gap > reach) continue;
+        const Vec2 v = centre + to_world(local_vertex_[j]);
+        hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, to_world(dq / dd), gap, cross(omega, v - centre)});
+      }
     }
+    return;
+  }
+  // Direct path (no prepared tables): world positions of one period's vertices, shared by its
+  // segments and vertices. Scratch grows once per thread.
+  thread_local std::vector<Vec2> pts;
+  if (pts.size() < profile.size()) pts.resize(profile.size());
+  for (int dk = -1; dk <= 1; ++dk) {
+    if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
+    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+    for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
     for (int j = 0; j < m; ++j) {
       const Vec2 a = pts[j];
       const Vec2 b = pts[j + 1];
       double t;
       const Vec2 q = closest_on_segment(a, b, c, t);
-      // Interior contacts only; convex vertices are handled below, concave vertices are
-      // covered by the interiors of their two faces.
       if (t <= 0.0 || t >= 1.0) continue;
       const Vec2 dq = c - q;
       const double dd2 = norm2(dq);
-      const double lim = r + reach;
-      if (dd2 > lim * lim || dd2 <= 0.0) continue;  // cheap reject before the square root
+      if (dd2 > lim * lim || dd2 <= 0.0) continue;
       const double dd = std::sqrt(dd2);
       const double gap = dd - r;
       if (gap > reach) continue;
       hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, dq / dd, gap, cross(omega, q - centre)});
     }
     for (int j = 0; j < m; ++j) {
-      // Vertex j is convex (seen from outside) if the profile turns towards the axis there:
-      // depth increases on the following segment relative to the straight continuation.
       const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - P, profile[m - 1].y} : profile[j - 1];
       const Vec2 cur = profile[j], next = profile[j + 1];
       if (cross(cur - prev, next - cur) <= 0.0) continue;  // concave or straight
       const Vec2 v = pts[j];
       const Vec2 dq = c - v;
       const double dd2 = norm2(dq);
-      const double lim = r + reach;
       if (dd2 > lim * lim || dd2 <= 0.0) continue;
       const double dd = std::sqrt(dd2);
       const double gap = dd - r;
@@ -151,6 +174,22 @@ void Wall::prepare() {
   }
   max_depth_ = 0.0;
   for (const auto& v : profile) max_depth_ = std::max(max_depth_, v.y);
+  const std::size_t nv = profile.size(), m = nv - 1;
+  local_vertex_.resize(nv);
+  for (std::size_t j = 0; j < nv; ++j) local_vertex_[j] = (radius - profile[j].y) * unit_offsets_[j];
+  local_edge_.resize(m);
+  local_inv_len2_.resize(m);
+  convex_.assign(m, 0);
+  for (std::size_t j = 0; j < m; ++j) {
+    local_edge_[j] = local_vertex_[j + 1] - local_vertex_[j];
+    const double l2 = norm2(local_edge_[j]);
+    local_inv_len2_[j] = l2 > 0.0 ? 1.0 / l2 : 0.0;
+    // Vertex j is convex (seen from outside) if the profile turns towards the axis there:
+    // depth increases on the following segment relative to the straight continuation.
+    const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - period(), profile[m - 1].y} : profile[j - 1];
+    convex_[j] = cross(profile[j] - prev, profile[j + 1] - profile[j]) > 0.0 ? 1 : 0;
+  }
+  prepared_profile_ = profile;
   prepared_radius_ = radius;
   prepared_period_ = period();
   prepared_phase_ = phase;

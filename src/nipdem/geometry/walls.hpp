@@ -79,6 +79,14 @@ struct Wall {
   std::vector<Vec2> period_units_;  // (cos, sin) of (k P + phase) / radius, roller frame, per period
   double prepared_radius_ = 0.0, prepared_period_ = 0.0, prepared_phase_ = 0.0;
   double max_depth_ = 0.0;          // deepest profile vertex [m]
+  // One period in its own frame (period start on the +x axis, origin at the centre): vertices,
+  // segment vectors and 1/|segment|^2, and which vertices are convex; query() turns the disc
+  // centre into that frame instead of every vertex into the world (prepare(); the profile they
+  // were made from is kept, so a changed profile falls back to the direct path).
+  std::vector<Vec2> local_vertex_, local_edge_;
+  std::vector<double> local_inv_len2_;
+  std::vector<std::uint8_t> convex_;
+  std::vector<Vec2> prepared_profile_;
   Vec2 angle_rotation_{1.0, 0.0};   // (cos, sin) of angle at the last prepare_angle()
   double prepared_angle_ = std::numeric_limits<double>::quiet_NaN();
   // Advances the prescribed motion by dt.
