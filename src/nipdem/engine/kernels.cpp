@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "nipdem/core/target_clones.hpp"
+
 namespace nipdem::engine::detail {
 
 namespace {
@@ -52,7 +54,7 @@ template <bool kAdhesion>
 
 }  // namespace
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
+NIPDEM_TARGET_CLONES
 void compute_pair_batch(const models::ContactParams& cp, const models::HamakerParams& hp, double dt, bool adhesion,
                         int n, PairBatch& b) {
   if (adhesion) lanes<true>(cp, hp, dt, n, b);
@@ -130,7 +132,7 @@ void rotate_by(double& c, double& s, double d) {
   s = s1 * f;
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
+NIPDEM_TARGET_CLONES
 void drift_bodies(const DriftParams& p, std::size_t b0, std::size_t b1, const BodyArrays& a) {
   if (p.newmark) {
     if (p.periodic) drift<true, true>(p, b0, b1, a);

@@ -8,6 +8,7 @@
 #include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
+#include "nipdem/core/target_clones.hpp"
 
 namespace nipdem::dipole {
 
@@ -203,9 +204,9 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
 // the scalar law (F_i = 3k/r^5 [a m_j + b m_i + (c - 5 a b / r^2) r], a = m_i.r, b = m_j.r,
 // c = m_i.m_j; one sqrt, one division), the same operations in the same order in every lane, so
 // each lane rounds as the scalar loop did. Compiled for AVX-512, AVX2 and generic x86-64 (GCC
-// target_clones, chosen at load time) with -ffp-contract=off (src/CMakeLists.txt): no clone
+// target_clones via NIPDEM_TARGET_CLONES, chosen at load time) with -ffp-contract=off (src/CMakeLists.txt): no clone
 // fuses a multiply-add, so every machine gets the same bits.
-__attribute__((target_clones("avx512f", "avx2", "default")))
+NIPDEM_TARGET_CLONES
 void dipole_row_forces(int n, double k3, double mix, double miy, const double* __restrict dxs, const double* __restrict dys,
                        const double* __restrict mjxs, const double* __restrict mjys, double* __restrict gxs,
                        double* __restrict gys) {
