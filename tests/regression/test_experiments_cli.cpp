@@ -178,6 +178,47 @@ TEST(ExperimentCli, TinyEdgeSharpnessObservesTheWholeAnalysisRange) {
   fs::remove_all(d);
 }
 
+// A Vo scan keeps each finished line (OUT/vo_level/lines/<index>.json): a seed interrupted in
+// the middle of its scan goes on from its last finished line and ends with the same trace; a
+// damaged file is set aside with a warning and its lines are run again.
+TEST(ExperimentCli, InterruptedVoScanResumesFromItsFinishedLines) {
+  const fs::path d = fs::temp_directory_path() / ("nipdem_exp_vo_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  const std::string cmd = "experiment vo-level --seeds 1 --v0 0 --step 10 --vmax 30 --line-start 0 --line-length 20e-6 "
+                          "--set inflow.prefill=false --set geometry.window_x_min_m=-100e-6 --set geometry.window_x_max_m=100e-6 "
+                          "--set collision.stiffness_scale=0.01 --json --quiet --out " + d.string();
+  const auto first = cli(cmd);
+  ASSERT_EQ(first.status, 0) << first.err;
+  const auto j1 = nlohmann::json::parse(first.out);
+  const auto trace = j1["per_seed"][0]["trace_V_printed"];
+  ASSERT_GE(trace.size(), 3u);  // a scan of several lines
+  EXPECT_EQ(j1["per_seed"][0]["lines_resumed"], 0);
+  const fs::path memo = d / "vo_level" / "lines" / "0.json";
+  auto m = nlohmann::json::parse(nipdem::io::read_file(memo));
+  ASSERT_EQ(m["lines_V_printed"], trace);
+  // Interrupted after two lines: the seed's result is missing, its memo holds two lines.
+  fs::remove(d / "vo_level" / "realizations" / "0.json");
+  m["lines_V_printed"].erase(m["lines_V_printed"].begin() + 2, m["lines_V_printed"].end());
+  nipdem::io::write_file_atomic(memo, m.dump());
+  const auto second = cli(cmd);
+  ASSERT_EQ(second.status, 0) << second.err;
+  const auto j2 = nlohmann::json::parse(second.out);
+  EXPECT_EQ(j2["per_seed"][0]["trace_V_printed"], trace);
+  EXPECT_EQ(j2["per_seed"][0]["lines_resumed"], 2);
+  EXPECT_EQ(j2["vo_mean_V"], j1["vo_mean_V"]);
+  EXPECT_EQ(nlohmann::json::parse(nipdem::io::read_file(memo))["lines_V_printed"], trace);
+  // A damaged memo is not trusted: warning, every line again, the same trace.
+  fs::remove(d / "vo_level" / "realizations" / "0.json");
+  nipdem::io::write_file_atomic(memo, "{\"seed\": 1, \"lines_V_printed\": [[0");
+  const auto third = cli(cmd);
+  ASSERT_EQ(third.status, 0) << third.err;
+  EXPECT_NE(third.err.find("unreadable"), std::string::npos) << third.err;
+  const auto j3 = nlohmann::json::parse(third.out);
+  EXPECT_EQ(j3["per_seed"][0]["trace_V_printed"], trace);
+  EXPECT_EQ(j3["per_seed"][0]["lines_resumed"], 0);
+  fs::remove_all(d);
+}
+
 // `calibrate cohesion` on tiny reduction runs: an unreachable target is reported (exit 1, JSON
 // with a hint) without losing the runs; a target between the two round-0 speeds is bracketed
 // on the rerun (round 0 resumed, not recomputed) and refined inside the bracket.

@@ -1,9 +1,14 @@
 #include "nipdem/experiments/vo_level.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fmt/format.h>
 
+#include "nipdem/core/crc32c.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/analysis/analysis.hpp"
+#include "nipdem/io/atomic_file.hpp"
 
 namespace nipdem::experiments {
 
@@ -22,14 +27,75 @@ void check(const VoOptions& v) {
   analysis::find_vo_level([](double) { return 1L; }, search_options(v));
 }
 
-// One seed: the part before the line once, then one line per voltage of the search.
-json run_seed_scan(const ExperimentOptions& o, const VoOptions& v, const nip::NipConfig& base, std::uint64_t seed) {
-  const auto prefix = print_prefix(o, base, v.print, seed);
+// The lines a seed's scan has finished, kept in OUT/vo_level/lines/<index>.json after each one, so
+// that an interrupted scan goes on where it stopped: the bisection asks for the same voltages in
+// the same order, and a voltage found there is not run again. The file names its seed and a
+// CRC-32C of the resolved configuration and the line's options; a file that does not match, or
+// cannot be read, is set aside with a warning and its lines are run again (never reused).
+class LineMemo {
+ public:
+  LineMemo(const ExperimentOptions& o, const nip::NipConfig& base, const PrintOptions& p, std::size_t index,
+           std::uint64_t seed)
+      : seed_(seed),
+        key_(crc32c(base.resolved_toml + fmt::format("\nline {:.17g} {:.17g} {:.17g}", p.line_start_m, p.line_length_m,
+                                                     p.extra_time_s))) {
+    if (o.out.empty()) return;  // results in memory only
+    file_ = o.out / "vo_level" / "lines" / (std::to_string(index) + ".json");
+    if (!o.resume || !std::filesystem::exists(file_)) return;
+    try {
+      const json j = json::parse(io::read_file(file_));
+      if (j.at("seed").get<std::uint64_t>() != seed_ || j.at("config_crc32c").get<std::uint32_t>() != key_) {
+        std::fprintf(stderr, "nipdem: warning: %s was made for another seed or configuration; running its lines again\n",
+                     file_.c_str());
+        return;
+      }
+      for (const auto& l : j.at("lines_V_printed")) lines_.push_back({l.at(0).get<double>(), l.at(1).get<long>()});
+    } catch (const std::exception& e) {
+      lines_.clear();
+      std::fprintf(stderr, "nipdem: warning: %s unreadable (%s); running its lines again\n", file_.c_str(), e.what());
+    }
+  }
+  const long* find(double V) const {
+    for (const auto& l : lines_)
+      if (l.first == V) return &l.second;
+    return nullptr;
+  }
+  void add(double V, long printed) {
+    lines_.push_back({V, printed});
+    if (file_.empty()) return;
+    json arr = json::array();
+    for (const auto& [v, n] : lines_) arr.push_back({v, n});
+    std::filesystem::create_directories(file_.parent_path());
+    io::write_file_atomic(file_, json{{"seed", seed_}, {"config_crc32c", key_}, {"lines_V_printed", arr}}.dump(1) + "\n");
+  }
+  std::size_t size() const { return lines_.size(); }
+
+ private:
+  std::uint64_t seed_;
+  std::uint32_t key_;
+  std::filesystem::path file_;
+  std::vector<std::pair<double, long>> lines_;
+};
+
+// One seed: the part before the line once (only if a line is still to run), then one line per
+// voltage of the search, each kept as it finishes (LineMemo).
+json run_seed_scan(const ExperimentOptions& o, const VoOptions& v, const nip::NipConfig& base, std::size_t index,
+                   std::uint64_t seed) {
+  LineMemo memo(o, base, v.print, index, seed);
+  const std::size_t resumed = memo.size();
+  std::optional<std::optional<std::string>> prefix;  // computed on first need
   const auto res = analysis::find_vo_level(
-      [&](double V) { return print_line(o, base, v.print, V, seed, 0.0, prefix ? &*prefix : nullptr).printed; }, search_options(v));
+      [&](double V) {
+        if (const long* n = memo.find(V)) return *n;
+        if (!prefix) prefix = print_prefix(o, base, v.print, seed);
+        const long n = print_line(o, base, v.print, V, seed, 0.0, *prefix ? &**prefix : nullptr).printed;
+        memo.add(V, n);
+        return n;
+      },
+      search_options(v));
   json trace = json::array();
   for (auto& [V, n] : res.trace) trace.push_back({V, n});
-  return json{{"found", res.found}, {"vo_V", res.vo_V}, {"trace_V_printed", trace}};
+  return json{{"found", res.found}, {"vo_V", res.vo_V}, {"trace_V_printed", trace}, {"lines_resumed", resumed}};
 }
 }  // namespace
 
@@ -39,7 +105,7 @@ json vo_level(const ExperimentOptions& o, const VoOptions& v) {
   reject_fixed_sets(o, "vo-level", print_fixed_keys(v.print, true));
   const nip::NipConfig base = base_config(o);
   print_config(base, v.print, 1.0, std::nullopt);
-  const auto sum = ensemble::run([&](std::size_t, std::uint64_t seed) { return run_seed_scan(o, v, base, seed); },
+  const auto sum = ensemble::run([&](std::size_t i, std::uint64_t seed) { return run_seed_scan(o, v, base, i, seed); },
                                  ensemble_options(o, static_cast<std::size_t>(v.seeds), "vo_level"));
   if (!sum.is_root) return {};
   std::vector<double> vo;
