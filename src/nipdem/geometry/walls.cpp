@@ -18,17 +18,6 @@ Vec2 Wall::profile_point(int k, Vec2 sd) const {
   return centre + Vec2{rr * std::cos(phi), rr * std::sin(phi)};
 }
 
-namespace {
-// Closest point on segment [a, b] to c; t in [0, 1].
-inline Vec2 closest_on_segment(Vec2 a, Vec2 b, Vec2 c, double& t) {
-  const Vec2 ab = b - a;
-  const double l2 = norm2(ab);
-  t = l2 > 0.0 ? dot(c - a, ab) / l2 : 0.0;
-  t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-  return a + t * ab;
-}
-}  // namespace
-
 void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const {
   if (kind == Kind::plane) {
     const double dist = dot(c - point, normal);
@@ -79,12 +68,55 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
                     prepared_phase_ == phase && static_cast<int>(period_units_.size()) == n_periods;
   const bool fast_angle = fast && prepared_angle_ == angle;
   const double lim = r + reach;
-  if (fast && prepared_profile_ == profile) {
-    // In the period's own frame: the centre is turned by the period's angle once, the vertices
-    // and segments are constants (prepare()); a hit is turned back into the world.
-    for (int dk = -1; dk <= 1; ++dk) {
-      if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
-      const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+  // One period in its own frame (period start on +x, origin at the centre): the centre cl, the
+  // vertices, segment vectors, 1/|segment|^2 and convexity; u turns that frame into the world.
+  // Segment interiors and convex vertices within reach become hits (concave vertices are covered
+  // by the interiors of their two faces).
+  auto test_period = [&](int k, Vec2 u, Vec2 cl, const Vec2* vert, const Vec2* edge, const double* inv_len2,
+                         const std::uint8_t* convex) {
+    auto to_world = [&](Vec2 v) { return Vec2{u.x * v.x - u.y * v.y, u.x * v.y + u.y * v.x}; };
+    for (int j = 0; j < m; ++j) {
+      const Vec2 a = vert[j], ab = edge[j];
+      const double t = dot(cl - a, ab) * inv_len2[j];
+      if (!(t > 0.0 && t < 1.0)) continue;  // (a NaN projection is no hit)
+      const Vec2 dq = cl - (a + t * ab);
+      const double dd2 = norm2(dq);
+      if (dd2 > lim * lim || dd2 <= 0.0) continue;  // cheap reject before the square root
+      const double dd = std::sqrt(dd2);
+      const double gap = dd - r;
+      if (gap > reach) continue;
+      const Vec2 q = centre + to_world(a + t * ab);
+      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, to_world(dq / dd), gap, cross(omega, q - centre)});
+    }
+    for (int j = 0; j < m; ++j) {
+      if (!convex[j]) continue;
+      const Vec2 dq = cl - vert[j];
+      const double dd2 = norm2(dq);
+      if (dd2 > lim * lim || dd2 <= 0.0) continue;
+      const double dd = std::sqrt(dd2);
+      const double gap = dd - r;
+      if (gap > reach) continue;
+      const Vec2 v = centre + to_world(vert[j]);
+      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, to_world(dq / dd), gap, cross(omega, v - centre)});
+    }
+  };
+  const bool prepared = fast && prepared_profile_ == profile;
+  // Direct path (no prepared tables): each period's vertices by trigonometry, in the world frame
+  // relative to the centre (u = identity). Scratch grows once per thread.
+  thread_local std::vector<Vec2> vert, edge;
+  thread_local std::vector<double> inv_len2;
+  thread_local std::vector<std::uint8_t> convex;
+  if (!prepared) {
+    vert.resize(profile.size()); edge.resize(m); inv_len2.resize(m); convex.resize(m);
+    for (int j = 0; j < m; ++j) {
+      const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - P, profile[m - 1].y} : profile[j - 1];
+      convex[j] = cross(profile[j] - prev, profile[j + 1] - profile[j]) > 0.0 ? 1 : 0;
+    }
+  }
+  for (int dk = -1; dk <= 1; ++dk) {
+    if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
+    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+    if (prepared) {
       Vec2 u;  // (cos, sin) of the polar angle of period k's s = 0 (no trigonometry when prepare_angle() saw this angle)
       if (fast_angle) {
         const Vec2 q = period_units_[k], a = angle_rotation_;
@@ -94,70 +126,15 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
         u = {std::cos(base), std::sin(base)};
       }
       const Vec2 cl{u.x * d.x + u.y * d.y, u.x * d.y - u.y * d.x};  // d turned by -angle(u)
-      auto to_world = [&](Vec2 v) { return Vec2{u.x * v.x - u.y * v.y, u.x * v.y + u.y * v.x}; };
+      test_period(k, u, cl, local_vertex_.data(), local_edge_.data(), local_inv_len2_.data(), convex_.data());
+    } else {
+      for (int j = 0; j <= m; ++j) vert[j] = profile_point(k, profile[j]) - centre;
       for (int j = 0; j < m; ++j) {
-        const Vec2 a = local_vertex_[j], ab = local_edge_[j];
-        const double t = dot(cl - a, ab) * local_inv_len2_[j];
-        // Interior contacts only; convex vertices are handled below, concave vertices are
-        // covered by the interiors of their two faces.
-        if (!(t > 0.0 && t < 1.0)) continue;
-        const Vec2 dq = cl - (a + t * ab);
-        const double dd2 = norm2(dq);
-        if (dd2 > lim * lim || dd2 <= 0.0) continue;  // cheap reject before the square root
-        const double dd = std::sqrt(dd2);
-        const double gap = dd - r;
-        if (gap > reach) continue;
-        const Vec2 q = centre + to_world(a + t * ab);
-        hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, to_world(dq / dd), gap, cross(omega, q - centre)});
+        edge[j] = vert[j + 1] - vert[j];
+        const double l2 = norm2(edge[j]);
+        inv_len2[j] = l2 > 0.0 ? 1.0 / l2 : 0.0;
       }
-      for (int j = 0; j < m; ++j) {
-        if (!convex_[j]) continue;
-        const Vec2 dq = cl - local_vertex_[j];
-        const double dd2 = norm2(dq);
-        if (dd2 > lim * lim || dd2 <= 0.0) continue;
-        const double dd = std::sqrt(dd2);
-        const double gap = dd - r;
-        if (gap > reach) continue;
-        const Vec2 v = centre + to_world(local_vertex_[j]);
-        hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, to_world(dq / dd), gap, cross(omega, v - centre)});
-      }
-    }
-    return;
-  }
-  // Direct path (no prepared tables): world positions of one period's vertices, shared by its
-  // segments and vertices. Scratch grows once per thread.
-  thread_local std::vector<Vec2> pts;
-  if (pts.size() < profile.size()) pts.resize(profile.size());
-  for (int dk = -1; dk <= 1; ++dk) {
-    if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
-    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
-    for (int j = 0; j <= m; ++j) pts[j] = profile_point(k, profile[j]);
-    for (int j = 0; j < m; ++j) {
-      const Vec2 a = pts[j];
-      const Vec2 b = pts[j + 1];
-      double t;
-      const Vec2 q = closest_on_segment(a, b, c, t);
-      if (t <= 0.0 || t >= 1.0) continue;
-      const Vec2 dq = c - q;
-      const double dd2 = norm2(dq);
-      if (dd2 > lim * lim || dd2 <= 0.0) continue;
-      const double dd = std::sqrt(dd2);
-      const double gap = dd - r;
-      if (gap > reach) continue;
-      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + j, q, dq / dd, gap, cross(omega, q - centre)});
-    }
-    for (int j = 0; j < m; ++j) {
-      const Vec2 prev = j == 0 ? Vec2{profile[m - 1].x - P, profile[m - 1].y} : profile[j - 1];
-      const Vec2 cur = profile[j], next = profile[j + 1];
-      if (cross(cur - prev, next - cur) <= 0.0) continue;  // concave or straight
-      const Vec2 v = pts[j];
-      const Vec2 dq = c - v;
-      const double dd2 = norm2(dq);
-      if (dd2 > lim * lim || dd2 <= 0.0) continue;
-      const double dd = std::sqrt(dd2);
-      const double gap = dd - r;
-      if (gap > reach) continue;
-      hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, dq / dd, gap, cross(omega, v - centre)});
+      test_period(k, {1.0, 0.0}, d, vert.data(), edge.data(), inv_len2.data(), convex.data());
     }
   }
 }
