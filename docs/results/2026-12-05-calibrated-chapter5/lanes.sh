@@ -19,6 +19,7 @@ if [[ ! -x $bin ]]; then
   cp "$src/build/nipdem" "$bin"
   git -C "$repo" worktree remove --force "$src"
 fi
+# JOBS=N gives each started lane N cores (run.sh)
 lanes=("$@")
 (( ${#lanes[@]} )) || lanes=(black color)
 for lane in "${lanes[@]}"; do

@@ -3,6 +3,7 @@
 # cut; docs/reduction.md), plus the 12-line edge study of the softening. Two lanes, one core each,
 # so that two invocations fill the two cores:    run.sh LANE [NIPDEM_BINARY]   (LANE = a | b: done; black | color: the chosen softening;
 # why: the colour Vo, one change at a time)
+# JOBS=N (default 1) gives one lane N cores, e.g. to finish one study before the next.
 # Resumable: every experiment resumes its realizations from its --out folder, and a step whose
 # JSON exists is skipped. A step's wall time goes to walltimes.txt.
 set -euo pipefail
@@ -16,7 +17,7 @@ step() {  # step NAME ARGS...: run `nipdem ARGS --out NAME --json` unless NAME.j
   [[ -s $name.json ]] && return 0
   mkdir -p "$(dirname "$name")"
   local t0; t0=$(date +%s)
-  if "$bin" "$@" --jobs 1 --out "$name" --json > "$name.json.tmp" 2> "$name.err"; then
+  if "$bin" "$@" --jobs "${JOBS:-1}" --out "$name" --json > "$name.json.tmp" 2> "$name.err"; then
     mv "$name.json.tmp" "$name.json"
     echo "$name $(( $(date +%s) - t0 )) s $("$bin" version | head -1)" >> walltimes.txt
   else
