@@ -83,19 +83,29 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     ny = std::max(1, static_cast<int>((ymax - ymin) / cell) + 1);
   }
   const double cwx = p.periodic_x ? L / nx : cell;
-  cell_head_.assign(static_cast<std::size_t>(nx) * ny, -1);
-  cell_next_.assign(n, -1);
   auto cell_x = [&](double xi) {
     int c = static_cast<int>(std::floor((xi - xmin) / cwx));
     if (p.periodic_x) { c %= nx; if (c < 0) c += nx; }
     return std::clamp(c, 0, nx - 1);
   };
   auto cell_y = [&](double yi) { return std::clamp(static_cast<int>((yi - ymin) / cell), 0, ny - 1); };
-  // Insert in reverse so each cell's chain runs in increasing index order.
-  for (std::size_t ii = n; ii-- > 0;) {
-    const int c = cell_y(y[ii]) * nx + cell_x(x[ii]);
-    cell_next_[ii] = cell_head_[c];
-    cell_head_[c] = static_cast<int>(ii);
+  // Bin by a counting sort: each cell's discs lie together (index order within a cell) with
+  // their coordinates, radius and body beside them, so the row search reads candidates from
+  // consecutive memory instead of chasing a linked list through the disc arrays.
+  const std::size_t ncell = static_cast<std::size_t>(nx) * ny;
+  cell_start_.assign(ncell + 1, 0);
+  cell_of_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int c = cell_y(y[i]) * nx + cell_x(x[i]);
+    cell_of_[i] = c;
+    ++cell_start_[static_cast<std::size_t>(c) + 1];
+  }
+  for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
+  cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
+  binned_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int k = cell_fill_[static_cast<std::size_t>(cell_of_[i])]++;
+    binned_[static_cast<std::size_t>(k)] = {x[i], y[i], r[i], static_cast<int>(i), body[i]};
   }
   // Rows are searched in parallel, each thread over one contiguous range of rows into its own
   // buffers, then concatenated in order: the list is the same for any thread count.
@@ -116,7 +126,9 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     std::vector<int>& row = out.row;
     for (std::size_t i = i_lo; i < i_hi; ++i) {
       row.clear();
-      const int cx = cell_x(x[i]), cy = cell_y(y[i]);
+      const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
+      const double xi = x[i], yi = y[i], ri = r[i];
+      const int bi = body[i], ii = static_cast<int>(i);
       for (int dyc = -1; dyc <= 1; ++dyc) {
         const int yy = cy + dyc;
         if (yy < 0 || yy >= ny) continue;
@@ -127,12 +139,14 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
           } else if (xx < 0 || xx >= nx) {
             continue;
           }
-          for (int j = cell_head_[yy * nx + xx]; j >= 0; j = cell_next_[j]) {
-            if (j <= static_cast<int>(i) || body[j] == body[i]) continue;
-            double dx = x[j] - x[i], dy = y[j] - y[i];
+          const std::size_t c = static_cast<std::size_t>(yy) * nx + xx;
+          for (int k = cell_start_[c], k1 = cell_start_[c + 1]; k < k1; ++k) {
+            const Binned& d = binned_[static_cast<std::size_t>(k)];
+            if (d.index <= ii || d.body == bi) continue;
+            double dx = d.x - xi, dy = d.y - yi;
             if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
-            const double rc = r[i] + r[j] + reach;
-            if (dx * dx + dy * dy < rc * rc) row.push_back(j);
+            const double rc = ri + d.r + reach;
+            if (dx * dx + dy * dy < rc * rc) row.push_back(d.index);
           }
         }
       }

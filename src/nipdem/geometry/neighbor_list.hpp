@@ -1,4 +1,4 @@
-// Verlet neighbour list built with a cell list (linked-cell binning), so building and using
+// Verlet neighbour list built with a cell list (discs binned by a counting sort), so building and using
 // it costs O(N). Half list in CSR form: row i holds neighbours j > i sorted by j, each with
 // its contact history (tangential stretch, sliding flag) so the pair loop has no lookups.
 // History survives rebuilds and renumbering (bodies removed/added): see rebuild().
@@ -97,7 +97,9 @@ class NeighborList {
   NeighborListParams params_;
   int builds_ = 0;
   // scratch reused across builds (no per-step allocation)
-  std::vector<int> cell_head_, cell_next_;
+  struct Binned { double x, y, r; int index, body; };  // a disc in cell order
+  std::vector<int> cell_start_, cell_fill_, cell_of_;
+  std::vector<Binned> binned_;
   std::vector<int> new_start_, new_nbr_;
   std::vector<double> new_eta_;
   std::vector<std::uint8_t> new_slide_;
