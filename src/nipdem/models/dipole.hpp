@@ -80,7 +80,9 @@ class PairSum {
   struct alignas(32) Packed { double x, y, mx, my; };
   std::vector<Packed> pk_;                 // per pass: centre and moment of every particle
   std::vector<std::vector<double>> buf_;   // per-thread force buffers (fx, fy interleaved)
-  std::vector<int> head_, next_;           // cell-list scratch
+  struct Binned { double x, y; int index; };  // a particle in cell order
+  std::vector<int> cell_start_, cell_fill_, cell_of_;  // cell-list scratch (counting sort)
+  std::vector<Binned> binned_;
   std::vector<int> cand_;
   int max_row_ = 0;                        // longest row of the list
   // Per part: one row's partners within r_c (separation, moment, index) and their forces
