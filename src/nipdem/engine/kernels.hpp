@@ -11,8 +11,10 @@
 // multiply are correctly rounded like their scalar forms; there is no fused multiply-add (none
 // of the clones enables FMA); and the sums into the discs stay scalar and in list order.
 // The functions here are compiled for AVX-512, AVX2 and generic x86-64 and picked at load
-// time (GCC target_clones), so a generic Debian build uses the wide units where they exist,
-// with identical results on every machine (no FMA contraction: src/CMakeLists.txt).
+// time (GCC target_clones), with identical results on every machine (no FMA contraction:
+// src/CMakeLists.txt). GCC 12 vectorises drift_bodies in its clones but leaves the pair loop
+// scalar in every clone ("no vectype"); written out per target it vectorises and gains nothing
+// measurable, since the law is a small part of the pair kernel (docs/performance.md, fifth pass).
 #pragma once
 #include <cstdint>
 
