@@ -240,6 +240,15 @@ void Simulation::build_wall_candidates() {
     for (std::size_t w = 0; w < nw; ++w)
       if (walls_[w].may_touch({d_.x[i], d_.y[i]}, d_.r[i], wall_reach_[w] + skin)) m |= std::uint32_t{1} << w;
     wall_mask_[i] = m;
+    // A disc that can touch no wall until the next build has no wall contact to remember: its
+    // history is cleared here (wall_disc() would clear it at this step's evaluation, which
+    // follows), so that wall_disc() need not be called for it at all.
+    if (m == 0 && d_.wall_key[i * kWallSlots] != -1)
+      for (int q = 0; q < kWallSlots; ++q) {
+        d_.wall_key[i * kWallSlots + q] = -1;
+        d_.wall_eta[i * kWallSlots + q] = 0.0;
+        d_.wall_slide[i * kWallSlots + q] = 0;
+      }
   }
 }
 
@@ -459,7 +468,7 @@ void Simulation::contact_forces() {
         if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
-      if (has_walls) {
+      if (has_walls && wall_mask_[i] != 0) {  // (most discs: no candidate wall, no call)
         try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
           wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
         } catch (...) {
@@ -499,7 +508,7 @@ void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, 
   double new_eta[kWallSlots];
   std::uint8_t new_sl[kWallSlots];
   const std::uint32_t mask = wall_mask_[i];
-  if (mask == 0 && d_.wall_key[i * kWallSlots] == -1) return;  // no candidate wall, no history to clear
+  if (mask == 0) return;  // no candidate wall, and no history (build_wall_candidates cleared it)
   const Vec2 c{d_.x[i], d_.y[i]};
   const double r = d_.r[i];
   int nnew = 0;
