@@ -77,7 +77,7 @@ TEST(DipolePass, ListSumEqualsBruteForceCutoffSum) {
 }
 
 TEST(DipolePass, ReusedListGivesBitwiseTheForcesOfAFreshList) {
-  // Particles drift and jiggle over 60 passes (0.15 um per pass, more than the 1 um half-skin
+  // Particles drift and jiggle over 60 passes (0.15 um per pass: two of them close the 2 um skin
   // over a few passes, so the list is rebuilt several times and reused in between). Each pass
   // must equal bitwise a pass with a list built just now (summation order independent of the
   // build time: checkpoint/resume exactness) and the brute-force sum to 1e-12 (round-off).
@@ -105,8 +105,9 @@ TEST(DipolePass, ReusedListGivesBitwiseTheForcesOfAFreshList) {
         cc.y[i] += vy[i] + r.uniform(-2e-8, 2e-8);
       }
     }
-    // A particle moves at most 0.24 um per pass: the half-skin (0.98 um) lasts at least 4
-    // passes, so at most 15 builds; the list is reused most of the time but not always.
+    // A particle moves at most 0.24 um per pass: two of them need at least 4 passes to add up
+    // to 0.98 of the 2 um skin, so at most 15 builds; the list is reused most of the time but
+    // not always.
     std::printf("threads=%d: %d list builds in 60 passes\n", threads, kept.builds());
     EXPECT_GE(kept.builds(), 5);
     EXPECT_LE(kept.builds(), 15);

@@ -41,9 +41,10 @@ Vec3 dipole_force3(Vec3 m_i, Vec3 m_j, Vec3 r_ij);
 //
 // PairSum evaluates this with a persistent Verlet pair list: pairs closer than r_c + skin are
 // listed once (half list, Newton's third law: each pair force is computed once and added to
-// i, subtracted from j), and the list is reused until a particle has moved more than skin/2
-// since it was built or the caller says the particle set changed. Every pass still tests
-// |r| < r_c exactly, so the result is the plain cut-off sum: the list only saves the search.
+// i, subtracted from j), and the list is reused until the two largest displacements since it
+// was built add up to more than the skin, or the caller says the particle set changed. Every
+// pass still tests |r| < r_c exactly, so the result is the plain cut-off sum: the list only
+// saves the search.
 // A pair (a < b) is listed in row a if a + b is even, else in row b, so rows are balanced
 // whatever the particle order; rows are sorted by partner index and the rows are split
 // between threads by index (not by list content). The summation order therefore depends only

@@ -156,7 +156,7 @@ void MagnetForce::field_pass(const BodyStore& b) {
 
 // Dipole-dipole forces (eqs. 2.4.38-2.4.39) between the induced moments within the cut-off:
 // dipole::PairSum keeps a Verlet pair list between passes (rebuilt when the body set changed
-// or a body moved more than skin/2) and sums each pair once. The result equals the plain
+// or the two largest displacements add up to the skin) and sums each pair once. The result equals the plain
 // cut-off sum (tested against an O(N^2) sum) and does not depend on when the list was built.
 void MagnetForce::dipole_pass(const BodyStore& b, bool same_set) {
   pairs_.compute(b.x, b.y, moment_, same_set, dfx_, dfy_, running_threads());
