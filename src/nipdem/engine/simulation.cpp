@@ -300,8 +300,9 @@ void Simulation::update_thread_split() {
 // list and its history), accumulates force and torque about the disc centre into f and the
 // adhesive part into fa (2 per disc). In three passes over batches of interacting pairs
 // (engine/kernels.hpp): a distance test per list entry that collects the pairs within
-// contact or adhesion range with their centre vector (and clears the history of those out of it); the contact law
-// (models::contact_force) on the whole batch at once, vectorised; then the sums into the discs,
+// contact or adhesion range with their centre vector (and clears the history of those out of
+// it); the contact law (models::contact_force) on the whole batch at once (one flat loop; GCC
+// 12 leaves it scalar, docs/performance.md fifth pass); then the sums into the discs,
 // scalar and in list order, the same additions in the same order as one loop over the list
 // would make (a row's own sum is accumulated apart and added when the row ends).
 template <bool kAdhesion, bool kPeriodic>
