@@ -204,7 +204,8 @@ TEST(RunSummary, CountsThePairListBuilds) {
   std::ifstream f(out + "/summary.json");
   const auto j = nlohmann::json::parse(f);
   const long steps = j.at("steps").get<long>();
-  for (const char* k : {"neighbor_list_builds_this_session", "dipole_list_builds_this_session"}) {
+  for (const char* k : {"neighbor_list_builds_this_session", "dipole_list_builds_this_session",
+                        "pair_sublist_builds_this_session"}) {
     EXPECT_GE(j.at(k).get<long>(), 1) << k;
     EXPECT_LE(j.at(k).get<long>(), steps) << k;
   }
@@ -312,4 +313,69 @@ TEST(TeamTuner, RunThreadsOutsideItsRangeIsRefused) {
       EXPECT_NE(std::string(e.what()).find("run_threads"), std::string::npos) << e.what();
     }
   }
+}
+
+// The pair kernel's per-step sublist (EngineParams::inner_skin_fraction) must not change a
+// result: it holds every listed pair within range + margin when taken, and is taken again
+// before two discs can have closed the margin, so the same pairs interact, in the same order.
+// Fast tri-disc clusters with adhesion collide in a periodic box and pile onto a floor (the
+// fastest discs move ~15 % of the margin 0.1 skin per step); bodies are removed and added on the
+// way, one body is moved by hand, and forces are evaluated once outside step(). The
+// state after 2000 steps is bitwise the same as when the kernel tests every listed pair, at 1
+// and 3 threads, and the sublist was taken far fewer times than there were steps (it was used).
+TEST(PairSublist, SameResultsAsTestingEveryListedPair) {
+  auto run = [](double fraction, int threads, int* takes) {
+    EngineParams p;
+    Interaction ia;
+    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
+    ia.adhesion.hamaker_J = 1e-19;
+    ia.adhesion.min_separation_m = 4e-10;
+    ia.adhesion.cutoff_m = 5e-8;
+    p.interactions = {ia, ia};
+    p.dt = 2e-9;
+    p.skin = 5e-7;
+    p.inner_skin_fraction = fraction;
+    p.gravity = {0, -1e4};
+    p.periodic_x = true;
+    p.x_lo = 0;
+    p.x_hi = 200e-6;
+    p.threads = threads;
+    p.run_threads = threads;
+    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    Rng rng(5);
+    auto add = [&](Vec2 pos) {
+      BodySpec s;
+      s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+      s.radii = {3e-6, 3e-6, 2.5e-6};
+      s.density = 1700;
+      s.position = pos;
+      s.angle = rng.uniform(0, 6.28);
+      s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};
+      s.omega = rng.uniform(-1e5, 1e5);
+      sim.add_body(s);
+    };
+    for (int row = 0; row < 14; ++row)
+      for (int col = 0; col < 14; ++col) add({14e-6 * col + 7e-6, 8e-6 + 14e-6 * row});
+    for (int k = 0; k < 2000; ++k) {
+      sim.step();
+      if (k == 700) sim.remove_bodies_if([](int b) { return b % 17 == 3; });
+      if (k == 900) add({100e-6, 230e-6});
+      if (k == 1200) sim.bodies().x[5] += 2e-8;  // moved by hand: seen as a displacement
+      if (k == 1500) sim.compute_forces();        // evaluated outside step(): every disc is checked
+    }
+    EXPECT_GT(sim.contacts(), 10);
+    *takes = sim.pair_sublist_builds();
+    const auto& b = sim.bodies();
+    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
+  };
+  int t_off = 0, t1 = 0, t3 = 0, t_wide = 0;
+  const auto every = run(0.0, 1, &t_off);
+  EXPECT_EQ(t_off, 0);
+  EXPECT_TRUE(every == run(0.1, 1, &t1));
+  EXPECT_TRUE(every == run(0.1, 3, &t3));
+  EXPECT_TRUE(every == run(0.5, 3, &t_wide));
+  EXPECT_GT(t1, 10);      // taken again and again as the discs move...
+  EXPECT_LT(t1, 1000);    // ...but used on most steps
+  EXPECT_EQ(t1, t3);
+  EXPECT_LT(t_wide, t1);  // a wider margin is taken less often
 }

@@ -132,6 +132,32 @@ void rotate_by(double& c, double& s, double d) {
   s = s1 * f;
 }
 
+namespace {
+template <bool kPeriodic>
+double max_disp2(const double* __restrict x, const double* __restrict y, const double* __restrict x0,
+                 const double* __restrict y0, std::size_t k0, std::size_t k1, double L) {
+  const double hL = 0.5 * L;
+  double m = 0.0;
+  for (std::size_t k = k0; k < k1; ++k) {
+    double dx = x[k] - x0[k];
+    const double dy = y[k] - y0[k];
+    if constexpr (kPeriodic) {
+      dx = dx > hL ? dx - L : dx;
+      dx = dx < -hL ? dx + L : dx;
+    }
+    const double d2 = dx * dx + dy * dy;
+    m = d2 > m ? d2 : m;
+  }
+  return m;
+}
+}  // namespace
+
+NIPDEM_TARGET_CLONES
+double max_displacement2(const double* x, const double* y, const double* x0, const double* y0, std::size_t k0,
+                         std::size_t k1, bool periodic, double L) {
+  return periodic ? max_disp2<true>(x, y, x0, y0, k0, k1, L) : max_disp2<false>(x, y, x0, y0, k0, k1, L);
+}
+
 NIPDEM_TARGET_CLONES
 void drift_bodies(const DriftParams& p, std::size_t b0, std::size_t b1, const BodyArrays& a) {
   if (p.newmark) {

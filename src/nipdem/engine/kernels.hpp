@@ -62,6 +62,12 @@ struct DriftParams {
 // rotate_large() (rare: a DEM step turns a body by far less).
 void drift_bodies(const DriftParams& p, std::size_t b0, std::size_t b1, const BodyArrays& a);
 
+// The largest squared displacement of discs [k0, k1) from their reference positions (x0, y0),
+// minimum image along x if periodic (box length L). NaN positions are not seen (the caller's
+// list check catches them).
+double max_displacement2(const double* x, const double* y, const double* x0, const double* y0, std::size_t k0,
+                         std::size_t k1, bool periodic, double L);
+
 // Rotates the unit vector (c, s) by the angle d (any size); the scalar form of the rotation in
 // drift_bodies, bitwise the same for |d| <= 1e-2.
 void rotate_by(double& c, double& s, double d);

@@ -32,6 +32,8 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   require_positive("engine", "dt_s", params_.dt);
   require_positive("engine", "skin_m", params_.skin);
   if (params_.threads < 1) throw_input("engine", "threads", std::to_string(params_.threads), "must be >= 1");
+  if (!(params_.inner_skin_fraction >= 0.0 && params_.inner_skin_fraction < 1.0))
+    throw_input("engine", "inner_skin_fraction", std::to_string(params_.inner_skin_fraction), "must be in [0, 1)");
   if (params_.run_threads < 0 || params_.run_threads > params_.threads)
     throw_input("engine", "run_threads", std::to_string(params_.run_threads), "must be 0 (adaptive) or 1..threads");
   if (params_.periodic_x && !(params_.x_hi > params_.x_lo))
@@ -305,8 +307,9 @@ void Simulation::update_thread_split() {
 // 12 leaves it scalar, docs/performance.md fifth pass); then the sums into the discs,
 // scalar and in list order, the same additions in the same order as one loop over the list
 // would make (a row's own sum is accumulated apart and added when the row ends).
-template <bool kAdhesion, bool kPeriodic>
-void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out) {
+template <bool kAdhesion, bool kPeriodic, int kList>
+void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out, SubEntry* sub,
+                           int& sub_n) {
   const ContactParams cp = params_.interactions[0].contact;
   const models::HamakerParams hp = params_.interactions[0].adhesion;
   const double dt = params_.dt;
@@ -373,20 +376,35 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   // velocities, history), for the pairs that interact: in a packing most listed pairs touch and
   // the distance test's loads are not repeated (1.085x on bench_lammps_packing), in the nip most
   // are apart and the extra stores cost little (1.03x on bench_nip).
-  for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) {
-    const int i = own[e], j = nb[e];
+  const double margin = sub_margin_;
+  int m = 0;
+  auto test = [&](int e, int i, int j) __attribute__((always_inline)) {
     const PackedDisc& pi = P[i];
     const PackedDisc& pj = P[j];
     const Vec2 d = separation(pi, pj);
     const double rc = (pi.r + pj.r) + reach;
-    const bool interacts = d.x * d.x + d.y * d.y < rc * rc;
+    const double d2 = d.x * d.x + d.y * d.y;
+    const bool interacts = d2 < rc * rc;
     B.e[n] = e; B.i[n] = i; B.j[n] = j; B.dx[n] = d.x; B.dy[n] = d.y;
     n += interacts ? 1 : 0;
+    if constexpr (kList == 1) {  // taken into the sublist within range + margin (also branch-free)
+      const double rm = rc + margin;
+      sub[m] = {e, i, j};
+      m += d2 < rm * rm ? 1 : 0;
+    }
     // History of a pair out of range is reset where there is some (rare: a contact that just
-    // opened); most stay clean, and a read keeps their cache lines clean (no write-back).
+    // opened); most stay clean, and a read keeps their cache lines clean (no write-back). A pair
+    // left out of the sublist is out of range when it is taken, so its history is clean then and
+    // stays so until the next sublist.
     if ((!interacts) & ((sl[e] != 0) | (eta[e] != 0.0))) { eta[e] = 0.0; sl[e] = 0; }
     if (n == detail::PairBatch::kN) flush();
+  };
+  if constexpr (kList == 2) {
+    for (int k = 0; k < sub_n; ++k) test(sub[k].e, sub[k].i, sub[k].j);
+  } else {
+    for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) test(e, own[e], nb[e]);
   }
+  if constexpr (kList == 1) sub_n = m;
   flush();
   close_row();
   nc_out = nc;
@@ -420,6 +438,32 @@ void Simulation::contact_forces() {
       if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
   thread_nc_.assign(nt, 0);
   if (has_walls) thread_fail_.assign(nt, nullptr);
+  // The per-step sublist: used while it was taken from this list build, thread split, reach and
+  // margin and no two discs can have closed the margin since; taken again otherwise.
+  const double margin = params_.inner_skin_fraction * params_.skin;
+  int list_mode = 0;
+  if (margin > 0.0) {
+    bool ok = sub_valid_ && sub_builds_ == nlist_.builds() && sub_threads_ == nt && sub_reach_ == pair_reach_ &&
+              sub_margin_ == margin && sub_x0_.size() == static_cast<std::size_t>(n);
+    if (ok) ok = sub_moved_ == 0 || (sub_moved_ < 0 && !sublist_moved());
+    list_mode = ok ? 2 : 1;
+    if (!ok) {
+      sub_valid_ = false;
+      sub_margin_ = margin;
+      sub_.resize(nt);
+      sub_n_.assign(nt, 0);
+      for (int u = 0; u < nt; ++u)
+        sub_[u].resize(static_cast<std::size_t>(nlist_.row_start_[split_[u + 1]] - nlist_.row_start_[split_[u]]));
+    }
+  }
+  sub_moved_ = -1;
+  int unused_n = 0;
+  auto run_rows = [&]<bool A, bool Per>(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc, SubEntry* sub,
+                                         int& sn) {
+    if (list_mode == 2) pair_rows<A, Per, 2>(i0, i1, f, fa, nc, sub, sn);
+    else if (list_mode == 1) pair_rows<A, Per, 1>(i0, i1, f, fa, nc, sub, sn);
+    else pair_rows<A, Per, 0>(i0, i1, f, fa, nc, sub, sn);
+  };
   const int run = team();  // threads that run the nt parts (results depend on nt only)
 #pragma omp parallel num_threads(run)
   {
@@ -446,12 +490,15 @@ void Simulation::contact_forces() {
         fa = ab.data();
       }
       std::int64_t nc = 0;
+      const int i1 = split_[u + 1];
+      SubEntry* sub = list_mode > 0 ? sub_[u].data() : nullptr;
+      int& sn = list_mode > 0 ? sub_n_[u] : unused_n;
       if (adh) {
-        if (periodic) pair_rows<true, true>(lo, split_[u + 1], buf.data(), fa, nc);
-        else pair_rows<true, false>(lo, split_[u + 1], buf.data(), fa, nc);
+        if (periodic) run_rows.template operator()<true, true>(lo, i1, buf.data(), fa, nc, sub, sn);
+        else run_rows.template operator()<true, false>(lo, i1, buf.data(), fa, nc, sub, sn);
       } else {
-        if (periodic) pair_rows<false, true>(lo, split_[u + 1], buf.data(), fa, nc);
-        else pair_rows<false, false>(lo, split_[u + 1], buf.data(), fa, nc);
+        if (periodic) run_rows.template operator()<false, true>(lo, i1, buf.data(), fa, nc, sub, sn);
+        else run_rows.template operator()<false, false>(lo, i1, buf.data(), fa, nc, sub, sn);
       }
       thread_nc_[u] = nc;
     }
@@ -488,6 +535,24 @@ void Simulation::contact_forces() {
   std::int64_t total = 0;
   for (auto c : thread_nc_) total += c;
   n_contacts_ = total;
+  if (list_mode == 1) {
+    sub_x0_.assign(d_.x.begin(), d_.x.end());
+    sub_y0_.assign(d_.y.begin(), d_.y.end());
+    sub_builds_ = nlist_.builds();
+    sub_threads_ = nt;
+    sub_reach_ = pair_reach_;
+    sub_valid_ = true;
+    ++sub_takes_;
+  }
+}
+
+bool Simulation::sublist_moved() const {
+  double m = 0.0;
+  for (std::size_t k = 0; k < d_.x.size(); ++k) {
+    const double d2 = sub_disp2(k);
+    if (!(d2 <= m)) m = d2 == d2 ? d2 : kInf;  // (a NaN position: taken again, and refused by the list)
+  }
+  return sub_exceeds(m);
 }
 
 void Simulation::prepare_walls() {
@@ -637,7 +702,9 @@ void Simulation::step() {
                                   fx, fy, tq, b_.mass.data(), b_.inertia.data(), inv_m, inv_I, dtheta_.data()};
   const detail::DriftParams drift{dt, newmark, periodic, params_.x_lo, params_.x_hi};
   const int nt = params_.threads;
-  thread_disp_.assign(2 * nt, 0.0);
+  thread_disp_.assign(4 * nt, 0.0);
+  // the per-step sublist's displacements too, if it may still be used (contact_forces())
+  const bool check_sub = check_moves && sub_valid_ && sub_x0_.size() == d_.x.size();
 #pragma omp parallel num_threads(team())
   {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
@@ -653,17 +720,28 @@ void Simulation::step() {
       for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
     }
   }
-  thread_disp_[2 * t] = d1;
-  thread_disp_[2 * t + 1] = d2;
+  thread_disp_[4 * t] = d1;
+  thread_disp_[4 * t + 1] = d2;
+  // The sublist's largest displacement, over this thread's discs (contiguous: bodies own
+  // consecutive discs), in a loop without branches. (A NaN position is caught by the list check above.)
+  if (check_sub && b1 > b0) {
+    const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[b0]);
+    const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[b1 - 1] + b_.n_discs[b1 - 1]);
+    thread_disp_[4 * t + 2] = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0, k1,
+                                                        periodic, params_.x_hi - params_.x_lo);
+  }
   }
   int moved = 0;
   if (check_moves) {
     double d1 = 0.0, d2 = 0.0;
+    double s1 = 0.0;
     for (int t = 0; t < nt; ++t) {
-      geometry::NeighborList::top2(thread_disp_[2 * t], d1, d2);
-      geometry::NeighborList::top2(thread_disp_[2 * t + 1], d1, d2);
+      geometry::NeighborList::top2(thread_disp_[4 * t], d1, d2);
+      geometry::NeighborList::top2(thread_disp_[4 * t + 1], d1, d2);
+      s1 = std::max(s1, thread_disp_[4 * t + 2]);
     }
     moved = nlist_.exceeds(d1, d2) ? 1 : 0;
+    if (check_sub) sub_moved_ = sub_exceeds(s1) ? 1 : 0;
   }
   for (auto& w : walls_) w.advance(dt);
   time_ += dt;

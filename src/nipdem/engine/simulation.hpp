@@ -73,6 +73,11 @@ struct EngineParams {
   Vec2 gravity{};                           // [m/s^2]
   std::vector<Interaction> interactions;    // [0] is disc-disc; walls refer to the others
   double skin = 1e-6;                       // Verlet skin [m]
+  // The pair kernel tests at each step only the listed pairs within their range plus this
+  // fraction of the skin: a sublist of the Verlet list, taken again when the two largest
+  // displacements since it was taken add up to that margin (docs/performance.md, sixth pass).
+  // Outputs do not depend on it (the same pairs interact, summed in the same order); 0 = off.
+  double inner_skin_fraction = 0.25;
   bool periodic_x = false;                  // periodic box along x
   double x_lo = 0.0, x_hi = 0.0;            // its extent [m]
   int threads = 1;                          // OpenMP threads for the force loops
@@ -142,6 +147,8 @@ class Simulation {
   std::vector<geometry::Wall>& walls() { return walls_; }
   const std::vector<geometry::Wall>& walls() const { return walls_; }
   const geometry::NeighborList& neighbor_list() const { return nlist_; }
+  // How often the pair kernel's per-step sublist was taken (EngineParams::inner_skin_fraction).
+  int pair_sublist_builds() const { return sub_takes_; }
   const std::vector<std::shared_ptr<BodyForce>>& forces() const { return forces_; }
   // Per-provider force on each body from the last evaluation (for output) [N].
   const std::vector<double>& provider_fx(std::size_t k) const { return prov_fx_[k]; }
@@ -180,8 +187,13 @@ class Simulation {
   struct alignas(32) PackedDisc { double x, y, r, m; };      // centre [m], radius [m], body mass [kg]
   struct alignas(32) PackedVel { double vx, vy, w, pad; };   // disc-centre velocity [m/s], body spin [rad/s]
   struct alignas(32) PackedForce { double fx, fy, tq, pad; };
-  template <bool kAdhesion, bool kPeriodic>
-  void pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc);
+  // One entry of the per-step sublist: the Verlet list entry and its two discs.
+  struct SubEntry { int e, i, j; };
+  // kList: 0 = test every entry of rows [i0, i1); 1 = the same, and take the sublist of those
+  // rows into sub/sub_n; 2 = test only the sublist sub[0, sub_n).
+  template <bool kAdhesion, bool kPeriodic, int kList>
+  void pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc, SubEntry* sub, int& sub_n);
+  bool sublist_moved() const;  // two largest displacements since the sublist exceed its margin
 
   EngineParams params_;
   std::vector<geometry::Wall> walls_;
@@ -219,6 +231,30 @@ class Simulation {
   int tuner_threads_ = 0, tuner_fixed_ = -1;  // the params the tuner was set up for
   int team();                                 // threads to run the loops of this step with
   double pair_reach_ = 0.0;  // max adhesion cut-off of disc-disc interaction
+  // The per-step sublist (EngineParams::inner_skin_fraction): per row chunk of the thread
+  // split, its entries, and what it was taken for (list build, threads, reach, margin, positions).
+  std::vector<std::vector<SubEntry>> sub_;
+  std::vector<int> sub_n_;
+  std::vector<double> sub_x0_, sub_y0_;
+  bool sub_valid_ = false;
+  int sub_moved_ = -1;  // set by step(): 0/1 = checked in its drift loop, -1 = unknown
+  int sub_builds_ = -1, sub_threads_ = 0, sub_takes_ = 0;
+  double sub_reach_ = -1.0, sub_margin_ = 0.0;
+  double sub_disp2(std::size_t k) const {
+    double dx = d_.x[k] - sub_x0_[k];
+    const double dy = d_.y[k] - sub_y0_[k];
+    if (params_.periodic_x) {  // a disc that crossed the periodic boundary moved by about +-L
+      const double L = params_.x_hi - params_.x_lo;
+      dx = dx > 0.5 * L ? dx - L : dx;
+      dx = dx < -0.5 * L ? dx + L : dx;
+    }
+    return dx * dx + dy * dy;
+  }
+  // True if two discs may have closed the margin since the sublist was taken: twice the largest
+  // squared displacement m. Reached a little early (0.99), so that rounding in the displacements
+  // never lets a pair left out of the sublist come into range unseen. (Twice the largest, not the
+  // two largest as for the list: the sublist is cheap to take again, and a plain max vectorises.)
+  bool sub_exceeds(double m) const { return 2.0 * std::sqrt(m) > 0.99 * sub_margin_; }
 };
 
 }  // namespace nipdem::engine

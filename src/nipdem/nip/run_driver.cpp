@@ -218,6 +218,8 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
       // magnet.dipole_skin_m; a change of the body set at an exchange rebuilds both)
       {"neighbor_list_builds_this_session", run.sim().neighbor_list().builds()},
       {"dipole_list_builds_this_session", run.magnet() ? run.magnet()->dipole_pairs().builds() : 0},
+      // and how often the pair kernel took its per-step sublist of the contact list (engine/simulation.hpp)
+      {"pair_sublist_builds_this_session", run.sim().pair_sublist_builds()},
       {"particles_in_window", run.sim().bodies().x.size()},
       {"discs_in_window", run.sim().discs().x.size()},
       {"inserted", run.inserted()},
