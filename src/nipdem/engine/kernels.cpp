@@ -1,6 +1,7 @@
 #include "nipdem/engine/kernels.hpp"
 
 #include <cmath>
+#include <cstring>
 
 #include "nipdem/core/target_clones.hpp"
 
@@ -137,7 +138,7 @@ template <bool kPeriodic>
 double max_disp2(const double* __restrict x, const double* __restrict y, const double* __restrict x0,
                  const double* __restrict y0, std::size_t k0, std::size_t k1, double L) {
   const double hL = 0.5 * L;
-  double m = 0.0;
+  std::int64_t m = 0;  // the bits of 0.0
   for (std::size_t k = k0; k < k1; ++k) {
     double dx = x[k] - x0[k];
     const double dy = y[k] - y0[k];
@@ -145,10 +146,17 @@ double max_disp2(const double* __restrict x, const double* __restrict y, const d
       dx = dx > hL ? dx - L : dx;
       dx = dx < -hL ? dx + L : dx;
     }
+    // d2 >= 0 (or NaN), and non-negative doubles order as their bit patterns do: an integer
+    // max, which vectorises (a floating max does not without -ffinite-math-only). A NaN's bits
+    // exceed every finite value's and infinity's, so it comes out as the max.
+    std::int64_t b;
     const double d2 = dx * dx + dy * dy;
-    m = d2 > m ? d2 : m;
+    std::memcpy(&b, &d2, sizeof b);
+    m = b > m ? b : m;
   }
-  return m;
+  double r;
+  std::memcpy(&r, &m, sizeof r);
+  return r;
 }
 }  // namespace
 

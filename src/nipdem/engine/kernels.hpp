@@ -63,8 +63,7 @@ struct DriftParams {
 void drift_bodies(const DriftParams& p, std::size_t b0, std::size_t b1, const BodyArrays& a);
 
 // The largest squared displacement of discs [k0, k1) from their reference positions (x0, y0),
-// minimum image along x if periodic (box length L). NaN positions are not seen (the caller's
-// list check catches them).
+// minimum image along x if periodic (box length L); NaN if a position is NaN.
 double max_displacement2(const double* x, const double* y, const double* x0, const double* y0, std::size_t k0,
                          std::size_t k1, bool periodic, double L);
 

@@ -723,7 +723,7 @@ void Simulation::step() {
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;
   // The sublist's largest displacement, over this thread's discs (contiguous: bodies own
-  // consecutive discs), in a loop without branches. (A NaN position is caught by the list check above.)
+  // consecutive discs), in a loop without branches.
   if (check_sub && b1 > b0) {
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[b0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[b1 - 1] + b_.n_discs[b1 - 1]);
@@ -738,7 +738,7 @@ void Simulation::step() {
     for (int t = 0; t < nt; ++t) {
       geometry::NeighborList::top2(thread_disp_[4 * t], d1, d2);
       geometry::NeighborList::top2(thread_disp_[4 * t + 1], d1, d2);
-      s1 = std::max(s1, thread_disp_[4 * t + 2]);
+      s1 = thread_disp_[4 * t + 2] > s1 || thread_disp_[4 * t + 2] != thread_disp_[4 * t + 2] ? thread_disp_[4 * t + 2] : s1;
     }
     moved = nlist_.exceeds(d1, d2) ? 1 : 0;
     if (check_sub) sub_moved_ = sub_exceeds(s1) ? 1 : 0;

@@ -254,7 +254,7 @@ class Simulation {
   // squared displacement m. Reached a little early (0.99), so that rounding in the displacements
   // never lets a pair left out of the sublist come into range unseen. (Twice the largest, not the
   // two largest as for the list: the sublist is cheap to take again, and a plain max vectorises.)
-  bool sub_exceeds(double m) const { return 2.0 * std::sqrt(m) > 0.99 * sub_margin_; }
+  bool sub_exceeds(double m) const { return !(2.0 * std::sqrt(m) <= 0.99 * sub_margin_); }  // (NaN: true)
 };
 
 }  // namespace nipdem::engine
