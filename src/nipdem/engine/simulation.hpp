@@ -9,7 +9,8 @@
 //    bitwise reproducible for a given thread count.
 //  - A pair contributes nothing unless it interacts, and history is reset the moment a
 //    contact opens, so results do not depend on when the neighbour list was rebuilt: this
-//    is what makes checkpoint/resume bitwise exact.
+//    is what makes checkpoint/resume bitwise exact. The same holds for the pair kernel's
+//    per-step sublist of the list (EngineParams::inner_skin_fraction).
 //  - Bodies are added/removed between steps; the neighbour list is rebuilt with the index
 //    mapping so tangential history survives renumbering.
 #pragma once
