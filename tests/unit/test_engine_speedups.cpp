@@ -379,3 +379,108 @@ TEST(PairSublist, SameResultsAsTestingEveryListedPair) {
   EXPECT_EQ(t1, t3);
   EXPECT_LT(t_wide, t1);  // a wider margin is taken less often
 }
+
+// The sublist also narrows the wall candidates: while it is in use, a disc queries only the
+// walls that were within reach + margin of it when it was taken. A rough roller turns under
+// the discs, so the candidates are taken again before its surface has moved half the margin.
+// Tri-disc clusters with adhesion rain onto a rough roller (15 um pyramids, radius 0.5 mm)
+// turning at 600 rad/s (0.3 m/s at its surface, 1.2 % of the margin per step) and a plane
+// floor at its side. After 6,000 steps the state is bitwise that of testing every candidate
+// wall and listed pair at every step, at 1 and 2 threads, and the sublist was used.
+TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
+  auto run = [](double fraction, int threads, int* takes) {
+    EngineParams p;
+    Interaction ia;
+    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
+    ia.adhesion.hamaker_J = 1e-19;
+    ia.adhesion.min_separation_m = 4e-10;
+    ia.adhesion.cutoff_m = 5e-8;
+    p.interactions = {ia, ia};
+    p.dt = 2e-9;
+    p.skin = 5e-7;
+    p.inner_skin_fraction = fraction;
+    p.gravity = {0, -2e4};
+    p.threads = threads;
+    p.run_threads = threads;
+    geometry::Wall roller;
+    roller.kind = geometry::Wall::Kind::cylinder;
+    roller.name = "roller";
+    roller.radius = 0.5e-3;
+    roller.centre = {0, -0.5e-3};
+    roller.omega = 600.0;
+    roller.interaction = 1;
+    geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
+    Simulation sim(p, {roller, test::plane_wall({0, -60e-6}, {0, 1}, 1, "floor")});
+    Rng rng(9);
+    for (int row = 0; row < 6; ++row)
+      for (int col = 0; col < 10; ++col) {
+        BodySpec s;
+        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+        s.radii = {3e-6, 3e-6, 2.5e-6};
+        s.density = 1700;
+        s.position = {14e-6 * col - 70e-6, 6e-6 + 14e-6 * row};
+        s.angle = rng.uniform(0, 6.28);
+        s.velocity = {rng.uniform(-0.5, 0.5), rng.uniform(-6, -3)};
+        s.omega = rng.uniform(-1e5, 1e5);
+        sim.add_body(s);
+      }
+    for (int k = 0; k < 6000; ++k) sim.step();
+    EXPECT_GT(sim.contacts(), 10);
+    *takes = sim.pair_sublist_builds();
+    const auto& b = sim.bodies();
+    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
+  };
+  int t0 = 0, t1 = 0, t2 = 0;
+  const auto every = run(0.0, 1, &t0);
+  EXPECT_TRUE(every == run(0.1, 1, &t1));
+  EXPECT_TRUE(every == run(0.1, 2, &t2));
+  EXPECT_GT(t1, 10);
+  EXPECT_LT(t1, 3000);
+}
+
+// The same where only the roller moves: discs at rest hover 30 nm above the roller's lands
+// (inside the adhesion reach there, 15 um out of it above a pit) while it turns at 10 m/s, so
+// lands and pits pass under them and the adhesion pulls them only over a land. The discs
+// alone (they move by nm) would never call for a new sublist; the roller's turning must (its
+// surface moves 40 % of the margin per step). Bitwise the same as testing every candidate wall
+// at every step; the test fails if the roller's turning is left out of the criterion.
+TEST(PairSublist, ATurningRoughRollerRenewsTheWallCandidates) {
+  auto run = [](double fraction, int* takes) {
+    EngineParams p;
+    Interaction ia;
+    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
+    ia.adhesion.hamaker_J = 1e-19;
+    ia.adhesion.min_separation_m = 4e-10;
+    ia.adhesion.cutoff_m = 5e-8;
+    p.interactions = {ia, ia};
+    p.dt = 2e-9;
+    p.skin = 5e-7;
+    p.inner_skin_fraction = fraction;
+    geometry::Wall roller;
+    roller.kind = geometry::Wall::Kind::cylinder;
+    roller.name = "roller";
+    roller.radius = 0.5e-3;
+    roller.centre = {0, 0};
+    roller.omega = 2e4;
+    roller.interaction = 1;
+    geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
+    Simulation sim(p, {roller});
+    const double r = 3e-6;
+    for (int k = 0; k < 40; ++k) {  // 40 discs 7 um apart along the top of the roller
+      const double phi = 1.2 + 7e-6 * k / roller.radius;
+      const double rho = roller.radius + r + 3e-8;
+      sim.add_body(test::disc_body(r, 1700, {rho * std::cos(phi), rho * std::sin(phi)}));
+    }
+    for (int k = 0; k < 1500; ++k) sim.step();
+    *takes = sim.pair_sublist_builds();
+    const auto& b = sim.bodies();
+    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
+  };
+  int t0 = 0, t1 = 0;
+  const auto every = run(0.0, &t0);
+  EXPECT_TRUE(every == run(0.1, &t1));
+  double vmax = 0.0;
+  for (double v : every[3]) vmax = std::max(vmax, std::fabs(v));
+  EXPECT_GT(vmax, 1e-5);  // the lands' adhesion pulls the discs (3.1e-5 m/s by the end)
+  EXPECT_GT(t1, 100);     // the roller's turning renews the candidates (751 times in 1,500 steps)
+}

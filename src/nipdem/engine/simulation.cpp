@@ -226,6 +226,7 @@ void Simulation::ensure_neighbor_list(int moved) {
 // masks stay valid while the shapes do; a changed shape rebuilds them (wall_shapes_changed).
 void Simulation::build_wall_candidates() {
   const std::size_t n = d_.x.size(), nw = walls_.size();
+  sub_valid_ = false;  // its wall candidates are a subset of these
   wall_mask_.assign(n, 0);
   wall_shape_.resize(nw);
   for (std::size_t w = 0; w < nw; ++w) wall_shape_[w] = shape_of(w);
@@ -446,6 +447,7 @@ void Simulation::contact_forces() {
     bool ok = sub_valid_ && sub_builds_ == nlist_.builds() && sub_threads_ == nt && sub_reach_ == pair_reach_ &&
               sub_margin_ == margin && sub_x0_.size() == static_cast<std::size_t>(n);
     if (ok) ok = sub_moved_ == 0 || (sub_moved_ < 0 && !sublist_moved());
+    if (ok && has_walls) ok = walls_within_margin();
     list_mode = ok ? 2 : 1;
     if (!ok) {
       sub_valid_ = false;
@@ -457,6 +459,11 @@ void Simulation::contact_forces() {
     }
   }
   sub_moved_ = -1;
+  // The wall candidates follow the sublist: taken with it, used with it (up to 32 walls, one
+  // mask bit each). Each disc's bits start cleared, so a disc without candidates has none.
+  const bool near_walls = has_walls && list_mode == 2 && walls_.size() <= 32;
+  const bool take_near = has_walls && list_mode == 1 && walls_.size() <= 32;
+  if (take_near) wall_near_.assign(static_cast<std::size_t>(n), 0u);
   int unused_n = 0;
   auto run_rows = [&]<bool A, bool Per>(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc, SubEntry* sub,
                                          int& sn) {
@@ -516,9 +523,13 @@ void Simulation::contact_forces() {
         if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
-      if (has_walls && wall_mask_[i] != 0) {  // (most discs: no candidate wall, no call)
+      // Walls: the candidates of the list build, or while the sublist is in use only those
+      // within reach + margin when it was taken (most discs: none, no call).
+      const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];
+      if (wm != 0) {
         try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
-          wall_disc(static_cast<std::size_t>(i), thread_hits_[t], wall_nc);
+          wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t], wall_nc);
+          if (take_near) wall_near_[i] = walls_near(static_cast<std::size_t>(i), margin, thread_hits_[t]);
         } catch (...) {
           if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
         }
@@ -541,9 +552,42 @@ void Simulation::contact_forces() {
     sub_builds_ = nlist_.builds();
     sub_threads_ = nt;
     sub_reach_ = pair_reach_;
+    sub_wall_angle_.resize(walls_.size());
+    for (std::size_t w = 0; w < walls_.size(); ++w) sub_wall_angle_[w] = walls_[w].angle;
     sub_valid_ = true;
     ++sub_takes_;
   }
+}
+
+// A rough cylinder's surface moves with its rotation: no point of it has moved more than
+// |angle change| x radius since the sublist was taken. Together with the discs' half margin
+// (sub_exceeds) that keeps a disc left without a wall candidate out of its reach. Planes and
+// smooth cylinders keep their shape as they move (a changed shape rebuilds the candidates).
+bool Simulation::walls_within_margin() const {
+  if (sub_wall_angle_.size() != walls_.size()) return false;
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    const auto& wall = walls_[w];
+    if (wall.kind != geometry::Wall::Kind::cylinder || !wall.rough()) continue;
+    if (!(std::fabs(wall.angle - sub_wall_angle_[w]) * wall.radius <= 0.49 * sub_margin_)) return false;
+  }
+  return true;
+}
+
+// The walls of disc i's candidates within reach + margin of it now (one bit per wall).
+std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) const {
+  const std::uint32_t mask = wall_mask_[i];
+  const Vec2 c{d_.x[i], d_.y[i]};
+  const double r = d_.r[i];
+  std::uint32_t near = 0;
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    if (!(mask >> w & 1u)) continue;
+    const double reach = wall_reach_[w] + margin;
+    if (!walls_[w].may_touch(c, r, reach)) continue;
+    hits.clear();
+    walls_[w].query(c, r, reach, hits);
+    if (!hits.empty()) near |= std::uint32_t{1} << w;
+  }
+  return near;
 }
 
 bool Simulation::sublist_moved() const {
@@ -567,13 +611,12 @@ void Simulation::prepare_walls() {
 }
 
 // Wall forces on disc i, added to its force arrays; wall history slots updated.
-void Simulation::wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc) {
+void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc) {
   const std::size_t nw = walls_.size();
   const double dt = params_.dt;
   std::int64_t new_key[kWallSlots];
   double new_eta[kWallSlots];
   std::uint8_t new_sl[kWallSlots];
-  const std::uint32_t mask = wall_mask_[i];
   if (mask == 0) return;  // no candidate wall, and no history (build_wall_candidates cleared it)
   const Vec2 c{d_.x[i], d_.y[i]};
   const double r = d_.r[i];

@@ -170,7 +170,9 @@ class Simulation {
   void ensure_neighbor_list(int moved);
   void contact_forces();
   void prepare_walls();
-  void wall_disc(std::size_t i, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
+  void wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
+  std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) const;
+  bool walls_within_margin() const;
   void reduce_body(std::size_t b);
   void provider_forces();
   void update_thread_split();
@@ -237,6 +239,8 @@ class Simulation {
   std::vector<std::vector<SubEntry>> sub_;
   std::vector<int> sub_n_;
   std::vector<double> sub_x0_, sub_y0_;
+  std::vector<std::uint32_t> wall_near_;  // per disc: candidate walls within reach + margin when taken
+  std::vector<double> sub_wall_angle_;    // wall angles when taken
   bool sub_valid_ = false;
   int sub_moved_ = -1;  // set by step(): 0/1 = checked in its drift loop, -1 = unknown
   int sub_builds_ = -1, sub_threads_ = 0, sub_takes_ = 0;
