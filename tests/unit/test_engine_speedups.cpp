@@ -212,6 +212,24 @@ TEST(RunSummary, CountsThePairListBuilds) {
   std::filesystem::remove_all(out);
 }
 
+namespace {
+// The engine of the thread and sublist tests: adhesive tri-disc contacts (k 40 N/m), dt 2 ns, skin 0.5 um
+// and the given sublist margin (a fraction of the skin; 0 = every listed pair each step).
+EngineParams sublist_params(double fraction) {
+  EngineParams p;
+  Interaction ia;
+  ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
+  ia.adhesion.hamaker_J = 1e-19;
+  ia.adhesion.min_separation_m = 4e-10;
+  ia.adhesion.cutoff_m = 5e-8;
+  p.interactions = {ia, ia};
+  p.dt = 2e-9;
+  p.skin = 5e-7;
+  p.inner_skin_fraction = fraction;
+  return p;
+}
+}  // namespace
+
 // How many threads run the engine's loops (EngineParams::run_threads; engine/team_tuner.hpp)
 // changes speed, never a result: the work is split into `threads` parts summed in one order.
 // Tri-disc clusters with adhesion collide in a periodic box and pile onto a floor; with
@@ -219,15 +237,7 @@ TEST(RunSummary, CountsThePairListBuilds) {
 // 3 after 200 steps and may switch) end bitwise alike.
 TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
   auto run = [](int run_threads) {
-    EngineParams p;
-    Interaction ia;
-    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
-    ia.adhesion.hamaker_J = 1e-19;
-    ia.adhesion.min_separation_m = 4e-10;
-    ia.adhesion.cutoff_m = 5e-8;
-    p.interactions = {ia, ia};
-    p.dt = 2e-9;
-    p.skin = 5e-7;
+    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);  // (the default sublist)
     p.gravity = {0, -1e4};
     p.periodic_x = true;
     p.x_lo = 0;
@@ -325,16 +335,7 @@ TEST(TeamTuner, RunThreadsOutsideItsRangeIsRefused) {
 // and 3 threads, and the sublist was taken far fewer times than there were steps (it was used).
 TEST(PairSublist, SameResultsAsTestingEveryListedPair) {
   auto run = [](double fraction, int threads, int* takes) {
-    EngineParams p;
-    Interaction ia;
-    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
-    ia.adhesion.hamaker_J = 1e-19;
-    ia.adhesion.min_separation_m = 4e-10;
-    ia.adhesion.cutoff_m = 5e-8;
-    p.interactions = {ia, ia};
-    p.dt = 2e-9;
-    p.skin = 5e-7;
-    p.inner_skin_fraction = fraction;
+    EngineParams p = sublist_params(fraction);
     p.gravity = {0, -1e4};
     p.periodic_x = true;
     p.x_lo = 0;
@@ -389,16 +390,7 @@ TEST(PairSublist, SameResultsAsTestingEveryListedPair) {
 // wall and listed pair at every step, at 1 and 2 threads, and the sublist was used.
 TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
   auto run = [](double fraction, int threads, int* takes) {
-    EngineParams p;
-    Interaction ia;
-    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
-    ia.adhesion.hamaker_J = 1e-19;
-    ia.adhesion.min_separation_m = 4e-10;
-    ia.adhesion.cutoff_m = 5e-8;
-    p.interactions = {ia, ia};
-    p.dt = 2e-9;
-    p.skin = 5e-7;
-    p.inner_skin_fraction = fraction;
+    EngineParams p = sublist_params(fraction);
     p.gravity = {0, -2e4};
     p.threads = threads;
     p.run_threads = threads;
@@ -446,16 +438,7 @@ TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
 // at every step; the test fails if the roller's turning is left out of the criterion.
 TEST(PairSublist, ATurningRoughRollerRenewsTheWallCandidates) {
   auto run = [](double fraction, int* takes) {
-    EngineParams p;
-    Interaction ia;
-    ia.contact = models::contact_params(40.0, 0.5, 1e-12, 0.5, 0.3);
-    ia.adhesion.hamaker_J = 1e-19;
-    ia.adhesion.min_separation_m = 4e-10;
-    ia.adhesion.cutoff_m = 5e-8;
-    p.interactions = {ia, ia};
-    p.dt = 2e-9;
-    p.skin = 5e-7;
-    p.inner_skin_fraction = fraction;
+    EngineParams p = sublist_params(fraction);
     geometry::Wall roller;
     roller.kind = geometry::Wall::Kind::cylinder;
     roller.name = "roller";
