@@ -12,7 +12,7 @@
 // On the dense state the fair magnet cost is its share inside the magnet run (stopwatch around
 // the provider): without the magnet that assembly falls apart (bench/README.md).
 //
-// Usage: bench_nip [--steps N=2000] [--settle N] [--threads T=1] [--half-width M=2.6e-3]
+// Usage: bench_nip [--steps N=2000] [--settle N] [--threads T=1] [--run-threads R=0] [--half-width M=2.6e-3]
 //                  [--state dense|loose] [--dense-file FILE] [--repeat R=1]
 //                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M (default magnet.dipole_skin_m, 8e-6)]
 //                  [--set key=value ...]   (extra config overrides, as `nipdem run --set`)
@@ -52,6 +52,7 @@ struct Result {
   std::size_t dipole_pairs = 0;   // listed dipole pairs (r < r_c + skin) at the end
   int builds = 0;
   long maxrss_kb = 0;
+  int threads_running = 1, thread_switches = 0;  // the engine's thread choice at the end (engine/team_tuner.hpp)
 };
 
 double cpu_seconds() {
@@ -297,6 +298,7 @@ State make_dense_state(const std::vector<std::string>& base, double press_time, 
 }
 
 double g_dipole_skin = -1;  // --dipole-skin: overrides magnet.dipole_skin_m
+int g_run_threads = 0;      // --run-threads: EngineParams::run_threads (0: the engine's measured choice)
 
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
   if (start) overrides.push_back("inflow.prefill=false");
@@ -318,6 +320,7 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
     timed = std::make_shared<TimedForce>(mf);
     sim.add_force(timed);
   }
+  sim.mutable_params().run_threads = std::min(g_run_threads, sim.params().threads);
   const double dt = nip.time_step().dt;
   if (start) {  // the same bodies in the same order (contact history starts empty)
     const auto& tmpl = nip::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
@@ -371,6 +374,8 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   r.contacts_per_disc = static_cast<double>(sim.contacts()) / static_cast<double>(sim.discs().x.size());
   coordination(sim, r.z_disc, r.z_body);
   r.maxrss_kb = maxrss_kb();
+  r.threads_running = sim.team_tuner().team();
+  r.thread_switches = sim.team_tuner().switches();
   if (print_params && timed) report_table_error(sim, magnet_cfg);
   return r;
 }
@@ -378,9 +383,10 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
 void print(const char* label, const Result& r, long steps) {
   std::printf("  %-28s particles=%zu discs=%zu wall=%.3f s cpu=%.3f s disc_steps_per_s=%.4g "
               "wall_per_simulated_ms=%.2f s contacts_per_disc=%.3f coordination_disc=%.2f coordination_body=%.2f list_builds=%d "
-              "peak_rss=%.1f MB magnet_share=%.1f %% dipole_list_builds=%d dipole_listed_pairs=%zu\n",
+              "peak_rss=%.1f MB magnet_share=%.1f %% dipole_list_builds=%d dipole_listed_pairs=%zu threads_running=%d thread_switches=%d\n",
               label, r.bodies, r.discs, r.wall_s, r.cpu_s, r.rate, r.wall_s / (r.sim_s * 1e3), r.contacts_per_disc, r.z_disc, r.z_body,
-              r.builds, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s, r.dipole_builds, r.dipole_pairs);
+              r.builds, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s, r.dipole_builds, r.dipole_pairs, r.threads_running,
+              r.thread_switches);
   (void)steps;
 }
 
@@ -411,7 +417,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> extra;
   bench::parse_args(argc, argv,
                     "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
-                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--set key=value]",
+                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--set key=value]",
                     {{"--steps", [&](const std::string& v) { steps = std::stol(v); }},
                      {"--settle", [&](const std::string& v) { settle = std::stol(v); }},
                      {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
@@ -421,6 +427,7 @@ int main(int argc, char** argv) {
                      {"--press-time", [&](const std::string& v) { press_time = std::stod(v); }},
                      {"--relax-steps", [&](const std::string& v) { relax_steps = std::stol(v); }},
                      {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = std::stod(v); }},
+                     {"--run-threads", [&](const std::string& v) { g_run_threads = std::max(0, std::stoi(v)); }},
                      {"--repeat", [&](const std::string& v) { repeat = std::max(1, std::stoi(v)); }},
                      {"--set", [&](const std::string& v) { extra.push_back(v); }}});
   if (state != "dense" && state != "loose") {
