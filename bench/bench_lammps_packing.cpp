@@ -24,6 +24,7 @@
 
 #include <sys/resource.h>
 
+#include "bench_args.hpp"
 #include "nipdem/core/wait_policy.hpp"
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/version.hpp"
@@ -161,18 +162,24 @@ int main(int argc, char** argv) {
       if (a + 1 >= argc) { usage(); std::exit(2); }
       return argv[++a];
     };
+    try {
     if (k == "--data") data = val();
-    else if (k == "--steps") steps = std::stol(val());
-    else if (k == "--warmup") warmup = std::stol(val());
-    else if (k == "--threads") threads = std::stoi(val());
-    else if (k == "--run-threads") run_threads = std::stoi(val());
-    else if (k == "--tilt-deg") tilt_deg = std::stod(val());
-    else if (k == "--every") every = std::stol(val());
+    else if (k == "--steps") steps = nipdem::bench::to_long(val());
+    else if (k == "--warmup") warmup = nipdem::bench::to_long(val());
+    else if (k == "--threads") threads = nipdem::bench::to_int(val());
+    else if (k == "--run-threads") run_threads = nipdem::bench::to_int(val());
+    else if (k == "--tilt-deg") tilt_deg = nipdem::bench::to_double(val());
+    else if (k == "--every") every = nipdem::bench::to_long(val());
     else if (k == "--inertia") {
       const std::string v = val();
       if (v != "disc" && v != "sphere") { usage(); return 2; }
       sphere_inertia = v == "sphere";
     } else { usage(); return 2; }
+    } catch (const std::exception& e) {  // a value that is not a number in full (bench_args.hpp)
+      std::fprintf(stderr, "bench_lammps_packing: %s '%s' not accepted (%s)\n", k.c_str(), argv[a], e.what());
+      usage();
+      return 2;
+    }
   }
   if (steps < 1 || warmup < 0 || threads < 1 || run_threads < 0 || run_threads > threads || every < 0 || !(std::fabs(tilt_deg) <= 90.0)) { usage(); return 2; }
 

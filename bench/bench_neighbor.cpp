@@ -27,13 +27,13 @@ int main(int argc, char** argv) {
       argc, argv,
       "bench_neighbor [--discs N=20000] [--builds K=200] [--per-body M=3] [--periodic 0|1] [--skin M=2.4e-6] "
       "[--extra-range M=4e-9] [--threads T=1] [--seed S=1]",
-      {{"--discs", [&](const std::string& v) { discs = std::stoi(v); }},
-       {"--builds", [&](const std::string& v) { builds = std::stoi(v); }},
-       {"--per-body", [&](const std::string& v) { per_body = std::stoi(v); }},
-       {"--periodic", [&](const std::string& v) { periodic = std::stoi(v); }},
-       {"--skin", [&](const std::string& v) { skin = std::stod(v); }},
-       {"--extra-range", [&](const std::string& v) { extra = std::stod(v); }},
-       {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
+      {{"--discs", [&](const std::string& v) { discs = nipdem::bench::to_int(v); }},
+       {"--builds", [&](const std::string& v) { builds = nipdem::bench::to_int(v); }},
+       {"--per-body", [&](const std::string& v) { per_body = nipdem::bench::to_int(v); }},
+       {"--periodic", [&](const std::string& v) { periodic = nipdem::bench::to_int(v); }},
+       {"--skin", [&](const std::string& v) { skin = nipdem::bench::to_double(v); }},
+       {"--extra-range", [&](const std::string& v) { extra = nipdem::bench::to_double(v); }},
+       {"--threads", [&](const std::string& v) { threads = nipdem::bench::to_int(v); }},
        {"--seed", [&](const std::string& v) { seed = std::stoull(v); }}});
   if (discs < 1 || builds < 1 || per_body < 1 || threads < 1) {
     std::fprintf(stderr, "bench_neighbor: --discs, --builds, --per-body and --threads must be >= 1\n");

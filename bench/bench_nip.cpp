@@ -320,7 +320,7 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
     timed = std::make_shared<TimedForce>(mf);
     sim.add_force(timed);
   }
-  sim.mutable_params().run_threads = std::min(g_run_threads, sim.params().threads);
+  sim.mutable_params().run_threads = g_run_threads;  // checked against --threads in main()
   const double dt = nip.time_step().dt;
   if (start) {  // the same bodies in the same order (contact history starts empty)
     const auto& tmpl = nip::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
@@ -418,18 +418,22 @@ int main(int argc, char** argv) {
   bench::parse_args(argc, argv,
                     "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
                     "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--set key=value]",
-                    {{"--steps", [&](const std::string& v) { steps = std::stol(v); }},
-                     {"--settle", [&](const std::string& v) { settle = std::stol(v); }},
-                     {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
+                    {{"--steps", [&](const std::string& v) { steps = nipdem::bench::to_long(v); }},
+                     {"--settle", [&](const std::string& v) { settle = nipdem::bench::to_long(v); }},
+                     {"--threads", [&](const std::string& v) { threads = nipdem::bench::to_int(v); }},
                      {"--half-width", [&](const std::string& v) { half_width = v; }},
                      {"--state", [&](const std::string& v) { state = v; }},
                      {"--dense-file", [&](const std::string& v) { dense_file = v; }},
-                     {"--press-time", [&](const std::string& v) { press_time = std::stod(v); }},
-                     {"--relax-steps", [&](const std::string& v) { relax_steps = std::stol(v); }},
-                     {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = std::stod(v); }},
-                     {"--run-threads", [&](const std::string& v) { g_run_threads = std::max(0, std::stoi(v)); }},
-                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, std::stoi(v)); }},
+                     {"--press-time", [&](const std::string& v) { press_time = nipdem::bench::to_double(v); }},
+                     {"--relax-steps", [&](const std::string& v) { relax_steps = nipdem::bench::to_long(v); }},
+                     {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = nipdem::bench::to_double(v); }},
+                     {"--run-threads", [&](const std::string& v) { g_run_threads = nipdem::bench::to_int(v); }},
+                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, nipdem::bench::to_int(v)); }},
                      {"--set", [&](const std::string& v) { extra.push_back(v); }}});
+  if (g_run_threads < 0 || g_run_threads > threads) {
+    std::fprintf(stderr, "bench_nip: --run-threads %d: must be 0 (the engine's measured choice) or 1..threads (%d)\n", g_run_threads, threads);
+    return 2;
+  }
   if (state != "dense" && state != "loose") {
     std::fprintf(stderr, "bench_nip: --state must be dense or loose\n");
     return 2;

@@ -82,12 +82,12 @@ int main(int argc, char** argv) {
   double x0 = -250e-6, x1 = 450e-6;
   std::vector<std::string> extra;
   bench::parse_args(argc, argv, "bench_print [--steps N] [--settle N] [--threads T] [--repeat R] [--x0 M] [--x1 M] [--set key=value]",
-                    {{"--steps", [&](const std::string& v) { steps = std::stol(v); }},
-                     {"--settle", [&](const std::string& v) { settle = std::stol(v); }},
-                     {"--threads", [&](const std::string& v) { threads = std::stoi(v); }},
-                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, std::stoi(v)); }},
-                     {"--x0", [&](const std::string& v) { x0 = std::stod(v); }},
-                     {"--x1", [&](const std::string& v) { x1 = std::stod(v); }},
+                    {{"--steps", [&](const std::string& v) { steps = nipdem::bench::to_long(v); }},
+                     {"--settle", [&](const std::string& v) { settle = nipdem::bench::to_long(v); }},
+                     {"--threads", [&](const std::string& v) { threads = nipdem::bench::to_int(v); }},
+                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, nipdem::bench::to_int(v)); }},
+                     {"--x0", [&](const std::string& v) { x0 = nipdem::bench::to_double(v); }},
+                     {"--x1", [&](const std::string& v) { x1 = nipdem::bench::to_double(v); }},
                      {"--set", [&](const std::string& v) { extra.push_back(v); }}});
   std::vector<std::string> base = {
       "geometry.window_x_min_m=-300e-6", "geometry.window_x_max_m=700e-6", "inflow.layer_thickness_m=0",
