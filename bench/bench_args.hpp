@@ -30,6 +30,12 @@ inline double to_double(const std::string& v) {
   return x;
 }
 
+// A value below `lo` is refused (std::out_of_range), never raised to it.
+template <class T> T at_least(T v, T lo) {
+  if (v < lo) throw std::out_of_range("must be >= " + std::to_string(lo));
+  return v;
+}
+
 // Every option takes one value; an unknown option, a missing value or a value its handler
 // refuses (it throws: not a number, out of range) prints the reason and `usage` and exits 2.
 inline void parse_args(int argc, char** argv, const std::string& usage,

@@ -418,17 +418,17 @@ int main(int argc, char** argv) {
   bench::parse_args(argc, argv,
                     "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
                     "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--set key=value]",
-                    {{"--steps", [&](const std::string& v) { steps = nipdem::bench::to_long(v); }},
-                     {"--settle", [&](const std::string& v) { settle = nipdem::bench::to_long(v); }},
-                     {"--threads", [&](const std::string& v) { threads = nipdem::bench::to_int(v); }},
+                    {{"--steps", [&](const std::string& v) { steps = nipdem::bench::at_least(nipdem::bench::to_long(v), 1L); }},
+                     {"--settle", [&](const std::string& v) { settle = nipdem::bench::at_least(nipdem::bench::to_long(v), 0L); }},
+                     {"--threads", [&](const std::string& v) { threads = nipdem::bench::at_least(nipdem::bench::to_int(v), 1); }},
                      {"--half-width", [&](const std::string& v) { half_width = v; }},
                      {"--state", [&](const std::string& v) { state = v; }},
                      {"--dense-file", [&](const std::string& v) { dense_file = v; }},
                      {"--press-time", [&](const std::string& v) { press_time = nipdem::bench::to_double(v); }},
-                     {"--relax-steps", [&](const std::string& v) { relax_steps = nipdem::bench::to_long(v); }},
+                     {"--relax-steps", [&](const std::string& v) { relax_steps = nipdem::bench::at_least(nipdem::bench::to_long(v), 0L); }},
                      {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = nipdem::bench::to_double(v); }},
                      {"--run-threads", [&](const std::string& v) { g_run_threads = nipdem::bench::to_int(v); }},
-                     {"--repeat", [&](const std::string& v) { repeat = std::max(1, nipdem::bench::to_int(v)); }},
+                     {"--repeat", [&](const std::string& v) { repeat = nipdem::bench::at_least(nipdem::bench::to_int(v), 1); }},
                      {"--set", [&](const std::string& v) { extra.push_back(v); }}});
   if (g_run_threads < 0 || g_run_threads > threads) {
     std::fprintf(stderr, "bench_nip: --run-threads %d: must be 0 (the engine's measured choice) or 1..threads (%d)\n", g_run_threads, threads);

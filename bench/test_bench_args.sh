@@ -17,6 +17,8 @@ check --run-threads "$dir/bench_nip" --run-threads abc
 check --steps "$dir/bench_nip" --steps 12x
 check --run-threads "$dir/bench_nip" --threads 1 --run-threads 2
 check --dipole-skin "$dir/bench_nip" --dipole-skin 1e999
+check --repeat "$dir/bench_nip" --repeat 0
+check --steps "$dir/bench_nip" --steps -5
 check --steps "$dir/bench_lammps_packing" --steps abc
 check --tilt-deg "$dir/bench_lammps_packing" --tilt-deg nanx
 check --steps "$dir/bench_print" --steps -
