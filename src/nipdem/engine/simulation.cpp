@@ -413,8 +413,8 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
 
 // Pair forces, wall forces and their sum per body, in one parallel region: pack the discs,
 // run the pair kernel on each thread's rows, reduce the thread buffers per disc and add the
-// wall forces of that disc, then sum per body.
-void Simulation::contact_forces() {
+// wall forces of that disc, then sum per body (and, with kick_h > 0, kick it: step()).
+void Simulation::contact_forces(double kick_h) {
   const int n = static_cast<int>(d_.x.size());
   const int nb = static_cast<int>(b_.x.size());
   const bool has_walls = !walls_.empty();
@@ -537,8 +537,19 @@ void Simulation::contact_forces() {
     }
     thread_nc_[t] += wall_nc;
     // (implicit barrier: a body's discs may lie in another thread's slice)
+    if (kick_h > 0.0) {
+      // The same operations as step()'s own kick loop, so the same bits.
+      double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
+      const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
 #pragma omp for schedule(static)
-    for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
+      for (int bb = 0; bb < nb; ++bb) {
+        reduce_body(static_cast<std::size_t>(bb));
+        vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
+      }
+    } else {
+#pragma omp for schedule(static)
+      for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
+    }
   }
   if (has_walls)
     for (const auto& e : thread_fail_)
@@ -790,10 +801,13 @@ void Simulation::step() {
   time_ += dt;
   ++step_;
   ensure_neighbor_list(check_moves ? moved : -1);
-  contact_forces();
+  // Without force providers nothing is added to the body forces after the contact sums, so the
+  // closing half kick runs in contact_forces()'s region (bitwise the loop below).
+  const bool kick_in_region = !newmark && forces_.empty();
+  contact_forces(kick_in_region ? 0.5 * dt : 0.0);
   provider_forces();
   forces_valid_ = true;
-  if (!newmark) {
+  if (!newmark && !kick_in_region) {
 #pragma omp parallel for schedule(static) num_threads(team())
     for (std::size_t b = 0; b < nb; ++b) {
       const double h = 0.5 * dt;
