@@ -467,3 +467,52 @@ TEST(PairSublist, ATurningRoughRollerRenewsTheWallCandidates) {
   EXPECT_GT(vmax, 1e-5);  // the lands' adhesion pulls the discs (3.1e-5 m/s by the end)
   EXPECT_GT(t1, 100);     // the roller's turning renews the candidates (751 times in 1,500 steps)
 }
+
+// Without force providers step() does the closing half kick inside the contact region, body by
+// body as its force is summed; with one it runs a loop of its own after the provider. A provider
+// that adds nothing takes the second path with the same forces, so both must give the same bits
+// (positions and velocities after 1,500 steps of clusters piling onto a floor, 1 and 3 threads).
+TEST(KickInContactRegion, SameBitsAsTheSeparateKickLoop) {
+  struct NoForce : BodyForce {
+    std::string name() const override { return "none"; }
+    void add(const BodyStore&, const DiscStore&, double, std::span<double>, std::span<double>, std::span<double>) override {}
+  };
+  auto run = [](int threads, bool with_provider) {
+    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);  // contacts with adhesion, the default sublist
+    p.gravity = {0, -1e4};
+    p.periodic_x = true;
+    p.x_lo = 0;
+    p.x_hi = 120e-6;
+    p.threads = threads;
+    p.run_threads = threads;
+    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    if (with_provider) sim.add_force(std::make_shared<NoForce>());
+    Rng rng(5);
+    for (int row = 0; row < 8; ++row)
+      for (int col = 0; col < 8; ++col) {
+        BodySpec s;
+        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+        s.radii = {3e-6, 3e-6, 2.5e-6};
+        s.density = 1700;
+        s.position = {14e-6 * col + 7e-6, 8e-6 + 14e-6 * row};
+        s.angle = rng.uniform(0, 6.28);
+        s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};
+        s.omega = rng.uniform(-1e5, 1e5);
+        sim.add_body(s);
+      }
+    std::int64_t most = 0;
+    for (int k = 0; k < 1500; ++k) {
+      sim.step();
+      most = std::max<std::int64_t>(most, sim.contacts());
+    }
+    EXPECT_GT(most, 10);  // the run exercises contacts (walls, adhesion), so the forces are not gravity alone
+    const auto& b = sim.bodies();
+    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
+  };
+  for (int threads : {1, 3}) {
+    SCOPED_TRACE(threads);
+    const auto fused = run(threads, false), separate = run(threads, true);
+    ASSERT_EQ(fused[0].size(), 64u);
+    EXPECT_TRUE(fused == separate);
+  }
+}
