@@ -19,6 +19,8 @@ check --run-threads "$dir/bench_nip" --threads 1 --run-threads 2
 check --dipole-skin "$dir/bench_nip" --dipole-skin 1e999
 check --repeat "$dir/bench_nip" --repeat 0
 check --steps "$dir/bench_nip" --steps -5
+check --sort-cell "$dir/bench_nip" --sort-cell -1
+check --sort-cell "$dir/bench_nip" --sort-cell nan
 check --steps "$dir/bench_lammps_packing" --steps abc
 check --tilt-deg "$dir/bench_lammps_packing" --tilt-deg nanx
 check --steps "$dir/bench_print" --steps -
