@@ -228,6 +228,36 @@ EngineParams sublist_params(double fraction) {
   p.inner_skin_fraction = fraction;
   return p;
 }
+// Periodic box with a floor: tri-disc clusters with adhesion and the default sublist, under a
+// strong gravity (shared by the thread-count and kick tests).
+EngineParams floor_box_params(double width, int threads, int run_threads) {
+  EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);
+  p.gravity = {0, -1e4};
+  p.periodic_x = true;
+  p.x_lo = 0;
+  p.x_hi = width;
+  p.threads = threads;
+  p.run_threads = run_threads;
+  return p;
+}
+
+// An n x n grid of such clusters, 14 um apart, random orientation, spin and downward velocity
+// (they collide and pile onto the floor).
+void add_cluster_grid(Simulation& sim, int n, std::uint64_t seed) {
+  Rng rng(seed);
+  for (int row = 0; row < n; ++row)
+    for (int col = 0; col < n; ++col) {
+      BodySpec s;
+      s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+      s.radii = {3e-6, 3e-6, 2.5e-6};
+      s.density = 1700;
+      s.position = {14e-6 * col + 7e-6, 8e-6 + 14e-6 * row};
+      s.angle = rng.uniform(0, 6.28);
+      s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};
+      s.omega = rng.uniform(-1e5, 1e5);
+      sim.add_body(s);
+    }
+}
 }  // namespace
 
 // How many threads run the engine's loops (EngineParams::run_threads; engine/team_tuner.hpp)
@@ -237,27 +267,8 @@ EngineParams sublist_params(double fraction) {
 // 3 after 200 steps and may switch) end bitwise alike.
 TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
   auto run = [](int run_threads) {
-    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);  // (the default sublist)
-    p.gravity = {0, -1e4};
-    p.periodic_x = true;
-    p.x_lo = 0;
-    p.x_hi = 200e-6;
-    p.threads = 3;
-    p.run_threads = run_threads;
-    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
-    Rng rng(11);
-    for (int row = 0; row < 14; ++row)
-      for (int col = 0; col < 14; ++col) {
-        BodySpec s;
-        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
-        s.radii = {3e-6, 3e-6, 2.5e-6};
-        s.density = 1700;
-        s.position = {14e-6 * col + 7e-6, 8e-6 + 14e-6 * row};
-        s.angle = rng.uniform(0, 6.28);
-        s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};  // collide, and pile onto the floor
-        s.omega = rng.uniform(-1e5, 1e5);
-        sim.add_body(s);
-      }
+    Simulation sim(floor_box_params(200e-6, 3, run_threads), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    add_cluster_grid(sim, 14, 11);
     for (int k = 0; k < 2000; ++k) sim.step();
     EXPECT_GT(sim.contacts(), 10);  // the run exercises contacts (21 open at the end; walls, adhesion)
     return std::pair{sim.bodies().x, sim.bodies().y};
@@ -478,28 +489,9 @@ TEST(KickInContactRegion, SameBitsAsTheSeparateKickLoop) {
     void add(const BodyStore&, const DiscStore&, double, std::span<double>, std::span<double>, std::span<double>) override {}
   };
   auto run = [](int threads, bool with_provider) {
-    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);  // contacts with adhesion, the default sublist
-    p.gravity = {0, -1e4};
-    p.periodic_x = true;
-    p.x_lo = 0;
-    p.x_hi = 120e-6;
-    p.threads = threads;
-    p.run_threads = threads;
-    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    Simulation sim(floor_box_params(120e-6, threads, threads), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
     if (with_provider) sim.add_force(std::make_shared<NoForce>());
-    Rng rng(5);
-    for (int row = 0; row < 8; ++row)
-      for (int col = 0; col < 8; ++col) {
-        BodySpec s;
-        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
-        s.radii = {3e-6, 3e-6, 2.5e-6};
-        s.density = 1700;
-        s.position = {14e-6 * col + 7e-6, 8e-6 + 14e-6 * row};
-        s.angle = rng.uniform(0, 6.28);
-        s.velocity = {rng.uniform(-1, 1), rng.uniform(-4, -1)};
-        s.omega = rng.uniform(-1e5, 1e5);
-        sim.add_body(s);
-      }
+    add_cluster_grid(sim, 8, 5);
     std::int64_t most = 0;
     for (int k = 0; k < 1500; ++k) {
       sim.step();
