@@ -3,6 +3,7 @@
 // are contiguous, so removing a body removes one index range. The engine's hot loops read
 // these arrays directly; nothing here knows about toner.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -17,7 +18,7 @@ struct BodyStore {
   // Total force [N] and torque about the centre of mass [N m] from the last force evaluation.
   std::vector<double> fx, fy, torque;
   std::vector<double> mass, inertia;     // [kg], [kg m^2] about the centre of mass (z axis)
-  std::vector<std::int64_t> id;          // stable identity (never reused within a run)
+  std::vector<std::int64_t> id;          // stable identity (never reused within a run; in no particular order)
   std::vector<int> first_disc, n_discs;  // discs [first_disc, first_disc + n_discs)
   std::vector<int> tag;                  // user tag (e.g. cluster template index)
   std::vector<double> size;              // user size measure (e.g. volume-equivalent diameter) [m]
@@ -39,6 +40,19 @@ struct BodyStore {
     f("id", s.id, 1); f("first_disc", s.first_disc, 1); f("n_discs", s.n_discs, 1); f("tag", s.tag, 1);
   }
 };
+
+// Index of the first body id that repeats an earlier one, or -1 if all are distinct. Ids are
+// distinct but in no particular order (the engine may reorder bodies); state read from a file
+// that keys anything by id checks this.
+inline long first_repeated_id(const std::vector<std::int64_t>& ids) {
+  std::vector<std::pair<std::int64_t, std::size_t>> s(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) s[i] = {ids[i], i};
+  std::sort(s.begin(), s.end());
+  long first = -1;
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (s[k].first == s[k - 1].first && (first < 0 || static_cast<long>(s[k].second) < first)) first = static_cast<long>(s[k].second);
+  return first;
+}
 
 // Wall contact history slots per disc: enough for a disc touching a drum, a roller face
 // and the two faces of a pit at once.

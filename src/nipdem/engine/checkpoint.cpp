@@ -116,10 +116,9 @@ void Simulation::load(std::istream& in) try {
   require_positive(b.mass, "body mass");
   require_positive(b.inertia, "body inertia");
   if (next_id < static_cast<std::int64_t>(nb)) bad(fmt::format("next body id {} < body count {}", next_id, nb));
-  for (std::size_t i = 0; i < nb; ++i) {
-    if (b.id[i] < 0 || b.id[i] >= next_id || (i > 0 && b.id[i] <= b.id[i - 1]))
-      bad(fmt::format("body id[{}] = {} is not increasing within [0, {})", i, b.id[i], next_id));
-  }
+  for (std::size_t i = 0; i < nb; ++i)
+    if (b.id[i] < 0 || b.id[i] >= next_id) bad(fmt::format("body id[{}] = {} is not within [0, {})", i, b.id[i], next_id));
+  if (const long k = first_repeated_id(b.id); k >= 0) bad(fmt::format("body id[{}] = {} repeats an earlier body's", k, b.id[k]));
   require_positive(d.r, "disc r");
   require_flags(d.wall_slide, "disc wall_slide");
   for (std::size_t k = 0; k < d.wall_key.size(); ++k) {

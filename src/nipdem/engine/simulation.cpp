@@ -8,6 +8,7 @@
 #include <limits>
 #include <ostream>
 #include <stdexcept>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <omp.h>
@@ -153,6 +154,63 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   structure_changed_ = true;
   forces_valid_ = false;
   return count;
+}
+
+void Simulation::permute_bodies(std::span<const int> order) {
+  const std::size_t nb = b_.x.size();
+  if (order.size() != nb) throw std::invalid_argument(fmt::format("permute_bodies: {} indices for {} bodies", order.size(), nb));
+  std::vector<char> seen(nb, 0);
+  for (const int i : order) {
+    if (i < 0 || static_cast<std::size_t>(i) >= nb || seen[static_cast<std::size_t>(i)])
+      throw std::invalid_argument(fmt::format("permute_bodies: index {} is out of range or repeated", i));
+    seen[static_cast<std::size_t>(i)] = 1;
+  }
+  // Source of every new body and disc entry; then every array gathered from its source.
+  std::vector<int> disc_src;
+  disc_src.reserve(d_.x.size());
+  for (const int i : order)
+    for (int k = 0; k < b_.n_discs[i]; ++k) disc_src.push_back(b_.first_disc[i] + k);
+  auto gather = [](const auto& src) {
+    return [&src](const char*, auto& v, std::size_t per) {
+      std::remove_reference_t<decltype(v)> out(src.size() * per);
+      for (std::size_t k = 0; k < src.size(); ++k)
+        for (std::size_t q = 0; q < per; ++q) out[k * per + q] = v[static_cast<std::size_t>(src[k]) * per + q];
+      v.swap(out);
+    };
+  };
+  b_.for_each_array(gather(order));
+  d_.for_each_array(gather(disc_src));
+  for (auto* pv : {&prov_fx_, &prov_fy_, &prov_tq_})
+    for (auto& v : *pv) gather(order)("", v, 1);
+  std::vector<int> old_of_new(disc_src.size());
+  for (std::size_t k = 0; k < disc_src.size(); ++k) old_of_new[k] = old_of_new_[static_cast<std::size_t>(disc_src[k])];
+  old_of_new_.swap(old_of_new);
+  for (std::size_t b = 0, k = 0; b < nb; ++b) {
+    b_.first_disc[b] = static_cast<int>(k);
+    for (int q = 0; q < b_.n_discs[b]; ++q) d_.body[k++] = static_cast<int>(b);
+  }
+  structure_changed_ = true;
+  ensure_neighbor_list(-1);  // now: energy() and the history mapping read the list
+}
+
+void Simulation::sort_bodies_spatially(double strip_m) {
+  require_positive("engine", "sort strip_m", strip_m);
+  const std::size_t nb = b_.x.size();
+  if (nb == 0) return;
+  // A state that is not finite is left as it is: the next list build reports where it blew up.
+  for (std::size_t i = 0; i < nb; ++i)
+    if (!std::isfinite(b_.x[i]) || !std::isfinite(b_.y[i])) return;
+  const double x0 = *std::min_element(b_.x.begin(), b_.x.end());
+  std::vector<double> strip(nb);  // strip numbers, kept as doubles (no overflow for any width)
+  for (std::size_t i = 0; i < nb; ++i) strip[i] = std::floor((b_.x[i] - x0) / strip_m);
+  std::vector<int> order(nb);
+  for (std::size_t i = 0; i < nb; ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return strip[a] != strip[b] ? strip[a] < strip[b] : b_.y[a] < b_.y[b];
+  });
+  bool identity = true;
+  for (std::size_t i = 0; i < nb && identity; ++i) identity = order[i] == static_cast<int>(i);
+  if (!identity) permute_bodies(order);
 }
 
 void Simulation::add_force(std::shared_ptr<BodyForce> f) {

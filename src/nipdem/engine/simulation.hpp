@@ -11,8 +11,10 @@
 //    contact opens, so results do not depend on when the neighbour list was rebuilt: this
 //    is what makes checkpoint/resume bitwise exact. The same holds for the pair kernel's
 //    per-step sublist of the list (EngineParams::inner_skin_fraction).
-//  - Bodies are added/removed between steps; the neighbour list is rebuilt with the index
-//    mapping so tangential history survives renumbering.
+//  - Bodies are added/removed/reordered between steps; the neighbour list is rebuilt with the
+//    index mapping so tangential history survives renumbering. The engine never reorders on its
+//    own: a caller that changes the body set anyway (the nip's inflow/outflow pass) sorts then
+//    (sort_bodies_spatially), at moments fixed by the run, so a resumed run sorts at the same steps.
 #pragma once
 #include <cstdint>
 #include <exception>
@@ -130,6 +132,15 @@ class Simulation {
   int add_body(const BodySpec& spec);
   // Removes every body for which pred(index) is true; returns how many.
   std::size_t remove_bodies_if(const std::function<bool(int)>& pred);
+  // Reorders the bodies (and their discs): new index k holds the body that was at order[k], a
+  // permutation of [0, bodies). Everything kept by index moves along (contact histories, the
+  // providers' last forces); the neighbour list is rebuilt at once. Forces stay valid: the next
+  // step is the same motion, its sums taken in the new order (equal up to rounding).
+  void permute_bodies(std::span<const int> order);
+  // Puts the bodies in spatial order, for memory locality in the pair loops and a thread split
+  // whose rows touch few discs beyond their own: strips strip_m wide in x (from the leftmost
+  // centre), by y within a strip, ties in the present order. Deterministic for a given state.
+  void sort_bodies_spatially(double strip_m);
   void add_force(std::shared_ptr<BodyForce> f);
 
   // Advances one time step (forces are (re)evaluated as needed).

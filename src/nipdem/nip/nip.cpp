@@ -21,6 +21,9 @@ namespace {
 // Random sequential addition stops after this many consecutive failed attempts: the pits are
 // then full to within a few per cent of the jammed fill (docs/geometry.md, "Filled pits").
 constexpr int kPitFillFailures = 400;
+// Strip width of the spatial body order [d50]: a few particles, so that a disc's neighbours lie
+// within a few strips (bench_nip: 1-3 d50 equal within noise, docs/performance.md ninth pass).
+constexpr double kSortStripD50 = 3.0;
 }  // namespace
 
 ReachableRegion reachable_region(const NipConfig& c) {
@@ -268,7 +271,8 @@ void NipRun::exchange() {
   // Outflow: bodies whose centre of mass left the window, classified by the nearer surface.
   const Vec2 cd = drum_centre(), cr = roller_centre();
   const double rough = cfg_.roughness ? cfg_.rough_height : 0.0;
-  sim_->remove_bodies_if([&](int i) {
+  const auto inserted0 = inserted_, inserted_roller0 = inserted_roller_;
+  const std::size_t removed = sim_->remove_bodies_if([&](int i) {
     const Vec2 p{b.x[i], b.y[i]};
     const double gd = norm(p - cd) - cfg_.drum_radius;
     const double gr = norm(p - cr) - cfg_.roller_radius;
@@ -297,6 +301,11 @@ void NipRun::exchange() {
   area_debt_ = std::min(area_debt_, 10.0 * pi * cfg_.size.d_max() * cfg_.size.d_max());
   // The sleeve brings its filled pits in through x_min (it moves towards +x).
   if (cfg_.roller_pits_filled) inserted_roller_ += fill_pits_entering(false);
+  // A changed body set is put in spatial order (the providers start afresh on a changed set
+  // anyway): inflow appends at the end, so without it neighbours drift apart in memory and the
+  // pair loops and the thread split slow down (docs/performance.md, ninth pass).
+  if (removed > 0 || inserted_ != inserted0 || inserted_roller_ != inserted_roller0)
+    sim_->sort_bodies_spatially(kSortStripD50 * cfg_.size.d50);
 }
 
 void NipRun::advance_to(double t_end, const std::function<void()>& on_interval) {

@@ -206,8 +206,8 @@ void MagnetForce::load(std::istream& in) {
   for (auto* v : {&ffx_, &ffy_, &dfx_, &dfy_}) require_finite_all(who, *v, "a held force");
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(moment_[i].x) || !std::isfinite(moment_[i].y)) bad_state(who, fmt::format("moment[{}] is not finite", i));
-    if (i > 0 && ids_[i] <= ids_[i - 1]) bad_state(who, fmt::format("body ids are not increasing at {}", i));
   }
+  if (const long k = first_repeated_id(ids_); k >= 0) bad_state(who, fmt::format("body id {} at {} repeats an earlier one", ids_[k], k));
   pairs_.invalidate();  // the list is a cache: rebuilt at the next pass, same forces (see PairSum)
 }
 
@@ -226,8 +226,7 @@ void ElectricForce::load(std::istream& in) {
   if (!std::isfinite(t_last_) || !std::isfinite(v_drum_)) bad_state(who, "last time or drum voltage not finite");
   require_len(who, u_, ids_.size(), "voltages");
   require_finite_all(who, u_, "voltage");
-  for (std::size_t i = 1; i < ids_.size(); ++i)
-    if (ids_[i] <= ids_[i - 1]) bad_state(who, fmt::format("body ids are not increasing at {}", i));
+  if (const long k = first_repeated_id(ids_); k >= 0) bad_state(who, fmt::format("body id {} at {} repeats an earlier one", ids_[k], k));
   // The per-body refresh data (all sized at the last refresh) are used without a refresh only if
   // they match the engine's body count; their disc indices must then be the engine's discs.
   const std::size_t nr = coupling_.size();
