@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The black 50-line edge study at dt = 0.08 t_n against the same 50 seeds at dt = 0.04 t_n.
 
-    /usr/bin/python3 compare.py [NEW_DIR [OLD_DIR]]     (defaults: black, the issue-17 edge50/black_k0.03)
+    /usr/bin/python3 compare.py [NEW_DIR [OLD_DIR [OUT_DIR [OLD_LABEL NEW_LABEL]]]]
+        (defaults: black, the issue-17 edge50/black_k0.03, this folder, "dt = 0.04 t_n" "dt = 0.08 t_n")
 
 Both studies ran the same command on the same 50 realization seeds (run.seed = 7), so each line
 has a partner: the only difference is the time step. Compared:
@@ -11,7 +12,7 @@ has a partner: the only difference is the time step. Compared:
     line starts and ends on the drum), and the covered length; mean paired difference with its
     standard error, and the Wilcoxon signed-rank p-value (scipy, if present);
   - the two average coverage curves in one figure (compare.png).
-Writes compare.json and compare.png next to this script.
+Writes compare.json and compare.png into OUT_DIR (../2026-12-06-edge-sorted uses it for its own pair).
 """
 import csv
 import json
@@ -23,6 +24,8 @@ import warnings
 here = os.path.dirname(os.path.abspath(__file__))
 new_dir = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "black")
 old_dir = sys.argv[2] if len(sys.argv) > 2 else os.path.join(here, "..", "2026-12-05-calibrated-chapter5", "edge50", "black_k0.03")
+out_dir = os.path.abspath(sys.argv[3]) if len(sys.argv) > 3 else here
+OLD_LABEL, NEW_LABEL = (sys.argv[4], sys.argv[5]) if len(sys.argv) > 5 else ("dt = 0.04 t_n", "dt = 0.08 t_n")
 LINE0, LINE1, MARGIN = 100.0, 250.0, 300.0  # um, the study's --line-start, end and --margin
 LO, HI = LINE0 - MARGIN, LINE1 + MARGIN
 
@@ -68,7 +71,7 @@ def mean_se(x):
 def main():
     a, b = lines(old_dir), lines(new_dir)
     common = sorted(set(a) & set(b))
-    res = {"old": os.path.relpath(old_dir, here), "new": os.path.relpath(new_dir, here), "paired_lines": len(common), "per_line": {}}
+    res = {"old": os.path.relpath(old_dir, out_dir), "new": os.path.relpath(new_dir, out_dir), "paired_lines": len(common), "per_line": {}}
     try:
         from scipy.stats import wilcoxon
     except ImportError:
@@ -95,10 +98,10 @@ def main():
                 "intervals_overlap": ia[0] <= ib[1] and ib[0] <= ia[1],
             }
         res["printed_total"] = {"old": ja["printed_particles"], "new": jb["printed_particles"]}
-    tmp = os.path.join(here, "compare.json.tmp")
+    tmp = os.path.join(out_dir, "compare.json.tmp")
     with open(tmp, "w") as f:
         json.dump(res, f, indent=1)
-    os.replace(tmp, os.path.join(here, "compare.json"))
+    os.replace(tmp, os.path.join(out_dir, "compare.json"))
     print(json.dumps(res, indent=1))
     try:
         import matplotlib
@@ -107,7 +110,7 @@ def main():
     except ImportError:
         return
     fig, ax = plt.subplots(figsize=(7, 3.6))
-    for d, label, st in ((old_dir, "dt = 0.04 t_n", "-"), (new_dir, "dt = 0.08 t_n", "--")):
+    for d, label, st in ((old_dir, OLD_LABEL, "-"), (new_dir, NEW_LABEL, "--")):
         p = os.path.join(d, "coverage_average.csv")
         if not os.path.exists(p):
             continue
@@ -122,8 +125,8 @@ def main():
     ax.set_title(f"Black, 50 lines, same seeds ({len(common)} pairs)")
     ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
-    fig.savefig(os.path.join(here, "compare.png.tmp.png"), dpi=120)
-    os.replace(os.path.join(here, "compare.png.tmp.png"), os.path.join(here, "compare.png"))
+    fig.savefig(os.path.join(out_dir, "compare.png.tmp.png"), dpi=120)
+    os.replace(os.path.join(out_dir, "compare.png.tmp.png"), os.path.join(out_dir, "compare.png"))
 
 
 if __name__ == "__main__":
