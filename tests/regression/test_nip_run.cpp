@@ -86,6 +86,37 @@ TEST(NipScenario, MagnetPullsTonerOffTheDrumIntoAnAssemblyAtTheKnife) {
   EXPECT_LT(std::fabs(knife[2]), 100e-6);
 }
 
+// After an inflow/outflow pass that changed the body set, the nip's bodies are in spatial order
+// (engine: strips 3 d50 wide in x from the leftmost centre, by y within a strip; docs/performance.md,
+// ninth pass): inflow appended its toner at the end, the sort moved it to its place.
+TEST(NipScenario, BodiesAreInSpatialOrderAfterAPassThatChangedTheSet) {
+  auto cfg = parse_nip_config(preset_text("black"), "preset:black", small_nip(1e-4));
+  NipRun run(cfg);
+  auto& sim = run.sim();
+  run.advance_to(2e-5);
+  const auto& b = sim.bodies();
+  bool changed = false;
+  for (int k = 0; k < 200 && !changed; ++k) {  // passes until inflow or outflow changes the set
+    const std::vector<std::int64_t> before = b.id;
+    for (int s = 0; s < cfg.insert_interval; ++s) sim.step();
+    run.exchange();
+    std::vector<std::int64_t> a = b.id, c = before;
+    std::sort(a.begin(), a.end());
+    std::sort(c.begin(), c.end());
+    changed = a != c;
+  }
+  ASSERT_TRUE(changed);
+  const double strip = 3.0 * cfg.size.d50;
+  const double x0 = *std::min_element(b.x.begin(), b.x.end());
+  bool ids_increasing = true;
+  for (std::size_t i = 1; i < b.x.size(); ++i) {
+    const double s0 = std::floor((b.x[i - 1] - x0) / strip), s1 = std::floor((b.x[i] - x0) / strip);
+    ASSERT_TRUE(s0 < s1 || (s0 == s1 && b.y[i - 1] <= b.y[i])) << "body " << i;
+    ids_increasing = ids_increasing && b.id[i] > b.id[i - 1];
+  }
+  EXPECT_FALSE(ids_increasing);  // not insertion order
+}
+
 TEST(NipCli, BadInputExitsTwoNamingFileKeyAndRange) {
   const fs::path d = temp_dir("badinput");
   const std::string preset = io::read_file(fs::path(NIPDEM_SOURCE_DIR) / "data/presets/black.toml");
