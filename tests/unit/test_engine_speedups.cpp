@@ -267,7 +267,7 @@ void add_cluster_grid(Simulation& sim, int n, std::uint64_t seed) {
 // changes speed, never a result: the work is split into `threads` parts summed in one order.
 // Tri-disc clusters with adhesion collide in a periodic box and pile onto a floor; with
 // threads = 3 the run on 1, 2 and 3 running threads and the measured choice (which probes 1 and
-// 3 after 200 steps and may switch) end bitwise alike.
+// 3 after the warm-up and may switch) end bitwise alike.
 TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
   auto run = [](int run_threads) {
     Simulation sim(floor_box_params(200e-6, 3, run_threads), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});

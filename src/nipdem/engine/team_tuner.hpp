@@ -19,7 +19,7 @@ namespace nipdem::engine {
 
 class TeamTuner {
  public:
-  static constexpr int kWarmupSteps = 200;   // before the first probe (lists, caches settle)
+  static constexpr int kWarmupSteps = 32;    // before the first probe (the first list build and page faults pass)
   static constexpr int kBlockSteps = 16;     // steps per probe block
   static constexpr int kProbeBlocks = 8;     // blocks per probe, alternating (4 per candidate)
   static constexpr int kHoldSteps = 4000;    // steps between probes (after a switch)
