@@ -5,10 +5,12 @@
 # dt = 0.08 t_n instead of the default 0.04, 50 lines on the 2 cores. The same run.seed (7), so
 # the same 50 realization seeds as ../2026-12-05-calibrated-chapter5/edge50/black_k0.03 (0.04):
 # a paired comparison, compare.py (writes compare.json and compare.png).
-#   run.sh [NIPDEM_BINARY]      resumable: the realizations already in black/ are kept
+#   run.sh [NIPDEM_BINARY [STUDY_DIR]]   resumable: the realizations already in STUDY_DIR/black/ are kept
+# STUDY_DIR (default: this folder) is a sibling results folder that reruns the same command with
+# another build (../2026-12-06-edge-sorted/run.sh).
 set -euo pipefail
 bin=${1:-$(cd "$(dirname "$0")" && pwd)/../../../build/nipdem}
-cd "$(dirname "$0")"
+cd "${2:-$(dirname "$0")}"
 ex=../../../examples
 t0=$(date +%s)
 "$bin" experiment edge-sharpness --config $ex/print_line_black.toml --line-start 0.1e-3 --line-length 0.15e-3 \

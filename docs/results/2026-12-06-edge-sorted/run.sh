@@ -6,12 +6,5 @@
 # the same physics: compare.sh compares it line by line with ../2026-12-06-edge-dt0.08/black.
 #   run.sh [NIPDEM_BINARY]      resumable: the realizations already in black/ are kept
 set -euo pipefail
-bin=${1:-$(cd "$(dirname "$0")" && pwd)/../../../build/nipdem}
-cd "$(dirname "$0")"
-ex=../../../examples
-t0=$(date +%s)
-"$bin" experiment edge-sharpness --config $ex/print_line_black.toml --line-start 0.1e-3 --line-length 0.15e-3 \
-  --margin 300e-6 --extra-time 0 --realizations 50 --jobs 2 --set run.dt_fraction_of_contact_time=0.08 \
-  --out black --json > black.json.tmp 2> black.err
-mv black.json.tmp black.json
-echo "black 50 lines $(( $(date +%s) - t0 )) s wall, $("$bin" version | head -1), started $(date -u -d @$t0 +%FT%TZ)" >> walltimes.txt
+here=$(cd "$(dirname "$0")" && pwd)
+exec "$here/../2026-12-06-edge-dt0.08/run.sh" "${1:-$here/../../../build/nipdem}" "$here"
