@@ -222,6 +222,14 @@ void Simulation::add_force(std::shared_ptr<BodyForce> f) {
 }
 
 // World positions of the discs of body b from its pose.
+// The pair kernel's copy of disc i: centre, radius and body mass; velocity of the disc centre.
+inline void Simulation::pack_disc(int i) {
+  const int b = d_.body[i];
+  const double w = b_.omega[b];
+  pdisc_[i] = {d_.x[i], d_.y[i], d_.r[i], b_.mass[b]};
+  pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
+}
+
 inline void Simulation::place_body(std::size_t b) {
   const int first = b_.first_disc[b], nd = b_.n_discs[b];
   const double X = b_.x[b], Y = b_.y[b];
@@ -472,7 +480,7 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
 // Pair forces, wall forces and their sum per body, in one parallel region: pack the discs,
 // run the pair kernel on each thread's rows, reduce the thread buffers per disc and add the
 // wall forces of that disc, then sum per body (and, with kick_h > 0, kick it: step()).
-void Simulation::contact_forces(double kick_h) {
+void Simulation::contact_forces(double kick_h, bool packed) {
   const int n = static_cast<int>(d_.x.size());
   const int nb = static_cast<int>(b_.x.size());
   const bool has_walls = !walls_.empty();
@@ -484,8 +492,10 @@ void Simulation::contact_forces(double kick_h) {
   const bool adh = params_.interactions[0].adhesion.hamaker_J != 0.0;
   const bool periodic = params_.periodic_x;
   update_thread_split();
-  pdisc_.resize(n);
-  pvel_.resize(n);
+  if (!packed) {
+    pdisc_.resize(n);
+    pvel_.resize(n);
+  }
   // Every buffer the region writes is sized here: nothing allocates inside it (an exception must
   // not cross an OpenMP region), except the wall queries' scratch, whose failures are carried out.
   if (static_cast<int>(tforce_.size()) != nt) tforce_.assign(nt, {});
@@ -533,27 +543,20 @@ void Simulation::contact_forces(double kick_h) {
 #pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();
+    if (!packed) {
 #pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
-      const int b = d_.body[i];
-      const double w = b_.omega[b];
-      pdisc_[i] = {d_.x[i], d_.y[i], d_.r[i], b_.mass[b]};
-      pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
+      for (int i = 0; i < n; ++i) pack_disc(i);
+      // (implicit barrier: every thread reads all packed discs)
     }
-    // (implicit barrier: every thread reads all packed discs)
     // Row chunk u (of nt) goes to thread u mod T: the same sums even if the runtime gave fewer
     // threads than asked for (OMP_DYNAMIC, OMP_THREAD_LIMIT, a nested region); one chunk each else.
     const int team_size = omp_get_num_threads();
     for (int u = t; u < nt; u += team_size) {
+      // The buffers are zero here: the reduce below clears each value as it reads it (one pass
+      // over them per step instead of two), and they start zero when they are allocated.
       auto& buf = tforce_[u];
-      const int lo = split_[u], hi = reach_hi_[u];
-      std::fill(buf.begin() + lo, buf.begin() + hi, PackedForce{0.0, 0.0, 0.0, 0.0});
-      double* fa = nullptr;
-      if (adh) {
-        auto& ab = tadh_[u];
-        std::fill(ab.begin() + 2 * lo, ab.begin() + 2 * hi, 0.0);
-        fa = ab.data();
-      }
+      const int lo = split_[u];
+      double* fa = adh ? tadh_[u].data() : nullptr;
       std::int64_t nc = 0;
       const int i1 = split_[u + 1];
       SubEntry* sub = list_mode > 0 ? sub_[u].data() : nullptr;
@@ -569,16 +572,25 @@ void Simulation::contact_forces(double kick_h) {
     }
     std::int64_t wall_nc = 0;
 #pragma omp barrier
-    // Reduce in fixed thread order (bitwise reproducible for a given thread count), each
-    // thread over its own slice of discs, adding only the buffers whose window covers it.
-#pragma omp for schedule(static)
-    for (int i = 0; i < n; ++i) {
+    // This thread's share of the bodies and their discs (bodies own consecutive discs): reduce
+    // each disc's thread buffers in fixed thread order (bitwise reproducible for a given thread
+    // count), add its wall forces, then sum its bodies (and kick them). A body's discs are in the
+    // same share as the body, so no barrier is needed between the discs and the bodies.
+    const int bl = static_cast<int>(static_cast<std::int64_t>(nb) * t / team_size);
+    const int bh = static_cast<int>(static_cast<std::int64_t>(nb) * (t + 1) / team_size);
+    const int k0 = bl < nb ? b_.first_disc[bl] : n, k1 = bh < nb ? b_.first_disc[bh] : n;
+    for (int i = k0; i < k1; ++i) {
       double a = 0, b = 0, c = 0, p = 0, q = 0;
       for (int u = 0; u < nt; ++u) {
         if (i < split_[u] || i >= reach_hi_[u]) continue;
-        const PackedForce& g = tforce_[u][i];
+        PackedForce& g = tforce_[u][i];
         a += g.fx; b += g.fy; c += g.tq;
-        if (adh) { p += tadh_[u][2 * i]; q += tadh_[u][2 * i + 1]; }
+        g = PackedForce{0.0, 0.0, 0.0, 0.0};
+        if (adh) {
+          double* h = &tadh_[u][2 * i];
+          p += h[0]; q += h[1];
+          h[0] = 0.0; h[1] = 0.0;
+        }
       }
       d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
       // Walls: the candidates of the list build, or while the sublist is in use only those
@@ -594,19 +606,16 @@ void Simulation::contact_forces(double kick_h) {
       }
     }
     thread_nc_[t] += wall_nc;
-    // (implicit barrier: a body's discs may lie in another thread's slice)
     if (kick_h > 0.0) {
       // The same operations as step()'s own kick loop, so the same bits.
       double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
       const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
-#pragma omp for schedule(static)
-      for (int bb = 0; bb < nb; ++bb) {
+      for (int bb = bl; bb < bh; ++bb) {
         reduce_body(static_cast<std::size_t>(bb));
         vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
       }
     } else {
-#pragma omp for schedule(static)
-      for (int bb = 0; bb < nb; ++bb) reduce_body(static_cast<std::size_t>(bb));
+      for (int bb = bl; bb < bh; ++bb) reduce_body(static_cast<std::size_t>(bb));
     }
   }
   if (has_walls)
@@ -817,6 +826,8 @@ void Simulation::step() {
   thread_disp_.assign(4 * nt, 0.0);
   // the per-step sublist's displacements too, if it may still be used (contact_forces())
   const bool check_sub = check_moves && sub_valid_ && sub_x0_.size() == d_.x.size();
+  pdisc_.resize(d_.x.size());
+  pvel_.resize(d_.x.size());
 #pragma omp parallel num_threads(team())
   {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
@@ -834,13 +845,16 @@ void Simulation::step() {
   }
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;
-  // The sublist's largest displacement, over this thread's discs (contiguous: bodies own
-  // consecutive discs), in a loop without branches.
-  if (check_sub && b1 > b0) {
+  // This thread's discs (contiguous: bodies own consecutive discs): the sublist's largest
+  // displacement, in a loop without branches, and the pair kernel's copy of them, which
+  // contact_forces() then need not make in a pass (and a barrier) of its own.
+  if (b1 > b0) {
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[b0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[b1 - 1] + b_.n_discs[b1 - 1]);
-    thread_disp_[4 * t + 2] = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0, k1,
-                                                        periodic, params_.x_hi - params_.x_lo);
+    if (check_sub)
+      thread_disp_[4 * t + 2] = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0,
+                                                          k1, periodic, params_.x_hi - params_.x_lo);
+    for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
   }
   }
   int moved = 0;
@@ -862,7 +876,7 @@ void Simulation::step() {
   // Without force providers nothing is added to the body forces after the contact sums, so the
   // closing half kick runs in contact_forces()'s region (bitwise the loop below).
   const bool kick_in_region = !newmark && forces_.empty();
-  contact_forces(kick_in_region ? 0.5 * dt : 0.0);
+  contact_forces(kick_in_region ? 0.5 * dt : 0.0, true);
   provider_forces();
   forces_valid_ = true;
   if (!newmark && !kick_in_region) {

@@ -177,11 +177,13 @@ class Simulation {
 
  private:
   void place_body(std::size_t b);
+  void pack_disc(int i);
   void update_disc_positions(std::size_t b0, std::size_t b1);
   void ensure_neighbor_list(int moved);
   // kick_h > 0: also the closing half kick of velocity Verlet, body by body as its force is summed
-  // (step() without force providers: one parallel region fewer per step)
-  void contact_forces(double kick_h = 0.0);
+  // (step() without force providers: one parallel region fewer per step); packed: step() has
+  // already made the pair kernel's copy of the discs (pdisc_, pvel_) from the present state
+  void contact_forces(double kick_h = 0.0, bool packed = false);
   void prepare_walls();
   void wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
   std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) const;
