@@ -124,35 +124,49 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     const std::size_t i_lo = n * t / T, i_hi = n * (t + 1) / T;
     Rows& out = rows_[t];
     std::vector<int>& row = out.row;
+    // The candidates of row i: the discs of the 3 x 3 cells around it with a larger index, of
+    // another body, within reach. Tested without a branch (the outcome is what a predictor
+    // cannot learn) into a buffer whose count moves on only for a pair that is kept.
+    int m = 0;
     for (std::size_t i = i_lo; i < i_hi; ++i) {
-      row.clear();
       const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
       const double xi = x[i], yi = y[i], ri = r[i];
       const int bi = body[i], ii = static_cast<int>(i);
+      m = 0;
+      auto scan = [&](int k, int k1) __attribute__((always_inline)) {
+        if (static_cast<std::size_t>(m + (k1 - k)) > row.size()) row.resize(static_cast<std::size_t>(2 * (m + (k1 - k))));
+        int* out = row.data();
+        for (; k < k1; ++k) {
+          const Binned& d = binned_[static_cast<std::size_t>(k)];
+          double dx = d.x - xi;
+          const double dy = d.y - yi;
+          if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
+          const double rc = ri + d.r + reach;
+          out[m] = d.index;
+          m += static_cast<int>((d.index > ii) & (d.body != bi) & (dx * dx + dy * dy < rc * rc));
+        }
+      };
       for (int dyc = -1; dyc <= 1; ++dyc) {
         const int yy = cy + dyc;
         if (yy < 0 || yy >= ny) continue;
-        for (int dxc = -1; dxc <= 1; ++dxc) {
-          int xx = cx + dxc;
-          if (p.periodic_x) {
-            xx = ((xx % nx) + nx) % nx;  // tiny boxes (nx < 3) give duplicates, removed below
-          } else if (xx < 0 || xx >= nx) {
-            continue;
-          }
-          const std::size_t c = static_cast<std::size_t>(yy) * nx + xx;
-          for (int k = cell_start_[c], k1 = cell_start_[c + 1]; k < k1; ++k) {
-            const Binned& d = binned_[static_cast<std::size_t>(k)];
-            if (d.index <= ii || d.body == bi) continue;
-            double dx = d.x - xi, dy = d.y - yi;
-            if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
-            const double rc = ri + d.r + reach;
-            if (dx * dx + dy * dy < rc * rc) row.push_back(d.index);
+        const std::size_t c_row = static_cast<std::size_t>(yy) * nx;
+        if (!p.periodic_x || (cx >= 1 && cx + 1 < nx)) {
+          // the (up to) three cells of this row of the stencil lie together in cell order
+          const std::size_t c0 = c_row + static_cast<std::size_t>(std::max(cx - 1, 0));
+          const std::size_t c1 = c_row + static_cast<std::size_t>(std::min(cx + 1, nx - 1));
+          scan(cell_start_[c0], cell_start_[c1 + 1]);
+        } else {
+          for (int dxc = -1; dxc <= 1; ++dxc) {
+            const int xx = ((cx + dxc) % nx + nx) % nx;  // tiny boxes (nx < 3) give duplicates, removed below
+            const std::size_t c = c_row + static_cast<std::size_t>(xx);
+            scan(cell_start_[c], cell_start_[c + 1]);
           }
         }
       }
-      std::sort(row.begin(), row.end());
-      row.erase(std::unique(row.begin(), row.end()), row.end());
-      for (int j : row) {
+      std::sort(row.begin(), row.begin() + m);
+      m = static_cast<int>(std::unique(row.begin(), row.begin() + m) - row.begin());
+      for (int q = 0; q < m; ++q) {
+        const int j = row[static_cast<std::size_t>(q)];
         out.nbr.push_back(j);
         double eta = 0.0;
         std::uint8_t sl = 0;
@@ -174,7 +188,7 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
         out.eta.push_back(eta);
         out.slide.push_back(sl);
       }
-      new_start_[i + 1] = static_cast<int>(row.size());  // count now, offset below
+      new_start_[i + 1] = m;  // count now, offset below
     }
   } catch (...) {
     failure[static_cast<std::size_t>(omp_get_thread_num())] = std::current_exception();
