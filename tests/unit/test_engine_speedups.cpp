@@ -175,8 +175,8 @@ TEST(WallCandidates, AWallMovedBetweenListBuildsIsFeltAtOnce) {
 }
 
 // The program chooses its OpenMP wait policy (core/wait_policy.hpp): with no policy in the
-// environment a run records passive waits; a user's own setting wins.
-TEST(WaitPolicy, TheCliSetsPassiveWaitsUnlessTheUserChose) {
+// environment a run records its short spin (GOMP_SPINCOUNT=10000); a user's own setting wins.
+TEST(WaitPolicy, TheCliSetsAShortSpinUnlessTheUserChose) {
   const std::string out = "/tmp/nipdem_waits_" + std::to_string(::getpid());
   const std::string args = std::string(" run ") + NIPDEM_SOURCE_DIR + "/examples/nip_black_small.toml --set run.end_time_s=2e-6 --force --out ";
   auto waits = [&](const std::string& env, const std::string& dir) {
@@ -189,10 +189,14 @@ TEST(WaitPolicy, TheCliSetsPassiveWaitsUnlessTheUserChose) {
     const auto k = s.find("\"omp_waits\"");
     return k == std::string::npos ? std::string("(missing)") : s.substr(k, s.find('\n', k) - k);
   };
-  EXPECT_NE(waits("", out + "_a").find("OMP_WAIT_POLICY=passive"), std::string::npos);
+  const std::string own = waits("", out + "_a");
+  EXPECT_NE(own.find("GOMP_SPINCOUNT=10000"), std::string::npos) << own;
+  EXPECT_EQ(own.find("OMP_WAIT_POLICY"), std::string::npos) << own;
   EXPECT_NE(waits("OMP_WAIT_POLICY=active", out + "_b").find("OMP_WAIT_POLICY=active"), std::string::npos);
+  EXPECT_NE(waits("GOMP_SPINCOUNT=0", out + "_c").find("GOMP_SPINCOUNT=0"), std::string::npos);
   std::filesystem::remove_all(out + "_a");
   std::filesystem::remove_all(out + "_b");
+  std::filesystem::remove_all(out + "_c");
 }
 
 // summary.json counts the builds of the contact and dipole pair lists (what the skins trade

@@ -14,9 +14,9 @@ void apply_wait_policy(char** argv) {
   const ssize_t len = readlink("/proc/self/exe", path, sizeof path - 1);
   if (len <= 0 || len >= static_cast<ssize_t>(sizeof path - 1)) return;
   path[len] = '\0';
-  if (setenv("OMP_WAIT_POLICY", kWaitPolicy, 1) != 0) return;
+  if (setenv(kWaitVariable, kWaitPolicy, 1) != 0) return;
   execv(path, argv);
-  unsetenv("OMP_WAIT_POLICY");  // exec failed: go on with libgomp's default
+  unsetenv(kWaitVariable);  // exec failed: go on with libgomp's default
 }
 
 std::string wait_policy() {
