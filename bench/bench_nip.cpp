@@ -15,6 +15,7 @@
 // Usage: bench_nip [--steps N=2000] [--settle N] [--threads T=1] [--run-threads R=0] [--half-width M=2.6e-3]
 //                  [--state dense|loose] [--dense-file FILE] [--repeat R=1]
 //                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M (default magnet.dipole_skin_m, 8e-6)]
+//                  [--inner-skin F (EngineParams::inner_skin_fraction, speed only)]
 //                  [--sort-cell M (0: the state's own order)] [--set key=value ...]   (extra config overrides, as `nipdem run --set`)
 // --sort-cell M adds the start state's bodies in spatial order (strips M wide in x, by y within a
 // strip) instead of the order they were made in: what memory locality is worth (bench/README.md,
@@ -128,6 +129,7 @@ class TimedForce final : public engine::BodyForce {
   void add(const BodyStore& b, const DiscStore& d, double t, std::span<double> fx, std::span<double> fy,
            std::span<double> tq) override {
     const auto t0 = std::chrono::steady_clock::now();
+    f_->set_running_threads(running_threads());  // the engine's thread choice reaches the magnet's loops
     f_->add(b, d, t, fx, fy, tq);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
@@ -303,6 +305,7 @@ State make_dense_state(const std::vector<std::string>& base, double press_time, 
 
 double g_dipole_skin = -1;  // --dipole-skin: overrides magnet.dipole_skin_m
 int g_run_threads = 0;      // --run-threads: EngineParams::run_threads (0: the engine's measured choice)
+double g_inner_skin = -1;  // --inner-skin: EngineParams::inner_skin_fraction (speed only; <0: the engine's)
 double g_sort_cell = 0;     // --sort-cell: strip width [m] of the start state's spatial order (0: file order)
 
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
@@ -326,6 +329,7 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
     sim.add_force(timed);
   }
   sim.mutable_params().run_threads = g_run_threads;  // checked against --threads in main()
+  if (g_inner_skin >= 0) sim.mutable_params().inner_skin_fraction = g_inner_skin;
   const double dt = nip.time_step().dt;
   if (start) {  // the same bodies in the same order (contact history starts empty)
     const auto& tmpl = nip::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
@@ -429,7 +433,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> extra;
   bench::parse_args(argc, argv,
                     "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
-                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--sort-cell M] [--set key=value]",
+                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--inner-skin F] [--sort-cell M] [--set key=value]",
                     {{"--steps", [&](const std::string& v) { steps = nipdem::bench::at_least(nipdem::bench::to_long(v), 1L); }},
                      {"--settle", [&](const std::string& v) { settle = nipdem::bench::at_least(nipdem::bench::to_long(v), 0L); }},
                      {"--threads", [&](const std::string& v) { threads = nipdem::bench::at_least(nipdem::bench::to_int(v), 1); }},
@@ -440,6 +444,10 @@ int main(int argc, char** argv) {
                      {"--relax-steps", [&](const std::string& v) { relax_steps = nipdem::bench::at_least(nipdem::bench::to_long(v), 0L); }},
                      {"--dipole-skin", [&](const std::string& v) { g_dipole_skin = nipdem::bench::to_double(v); }},
                      {"--run-threads", [&](const std::string& v) { g_run_threads = nipdem::bench::to_int(v); }},
+                     {"--inner-skin", [&](const std::string& v) {
+                        g_inner_skin = nipdem::bench::to_double(v);
+                        if (!(g_inner_skin >= 0 && g_inner_skin <= 1)) throw std::invalid_argument("must be in [0, 1]");
+                      }},
                      {"--sort-cell", [&](const std::string& v) {
                         g_sort_cell = nipdem::bench::to_double(v);
                         if (!(g_sort_cell >= 0 && g_sort_cell <= 1)) throw std::invalid_argument("must be in [0, 1] m");
