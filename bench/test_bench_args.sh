@@ -21,6 +21,8 @@ check --repeat "$dir/bench_nip" --repeat 0
 check --steps "$dir/bench_nip" --steps -5
 check --sort-cell "$dir/bench_nip" --sort-cell -1
 check --sort-cell "$dir/bench_nip" --sort-cell nan
+check --inner-skin "$dir/bench_nip" --inner-skin nan
+check --inner-skin "$dir/bench_nip" --inner-skin 2
 check --steps "$dir/bench_lammps_packing" --steps abc
 check --tilt-deg "$dir/bench_lammps_packing" --tilt-deg nanx
 check --steps "$dir/bench_print" --steps -
