@@ -19,8 +19,14 @@ import tomllib as _tomllib
 
 import numpy as _np
 
-from . import _nipdem
-from ._nipdem import git_hash, version
+# The engine's OpenMP waits: a short spin, as the CLI sets them (core/wait_policy.hpp,
+# docs/performance.md, tenth pass), unless the user chose. libgomp reads them once, when the
+# extension below loads it; if it was loaded before (by another module) they stay as they were.
+if "OMP_WAIT_POLICY" not in _os.environ and "GOMP_SPINCOUNT" not in _os.environ:
+    _os.environ["GOMP_SPINCOUNT"] = "10000"
+
+from . import _nipdem  # noqa: E402
+from ._nipdem import git_hash, version  # noqa: E402
 
 __all__ = [
     "Config", "Simulation", "preset", "preset_names", "load_config", "read_run",

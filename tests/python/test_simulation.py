@@ -233,3 +233,19 @@ def test_a_running_simulation_refuses_other_threads(small_config):
     worker.join()
     assert sim.time == pytest.approx(3e-4, abs=0.5 * sim.dt)  # the worker's run was not disturbed
     assert sim.bodies.x.shape == (sim.n_bodies,)             # and afterwards everything works
+
+
+def test_import_sets_the_cli_default_wait_unless_the_user_chose():
+    """libgomp reads its waits when the extension loads it: the package sets the CLI's default
+    (GOMP_SPINCOUNT=10000) before that, and leaves a user's own setting alone."""
+    import subprocess
+    import sys
+    probe = "import os, nipdem; print(os.environ.get('GOMP_SPINCOUNT'), os.environ.get('OMP_WAIT_POLICY'))"
+    base = {k: v for k, v in os.environ.items() if k not in ("GOMP_SPINCOUNT", "OMP_WAIT_POLICY")}
+    def run(extra):
+        r = subprocess.run([sys.executable, "-c", probe], env={**base, **extra}, capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        return r.stdout.split()
+    assert run({}) == ["10000", "None"]
+    assert run({"OMP_WAIT_POLICY": "passive"}) == ["None", "passive"]
+    assert run({"GOMP_SPINCOUNT": "0"}) == ["0", "None"]
