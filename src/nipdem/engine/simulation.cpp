@@ -221,7 +221,6 @@ void Simulation::add_force(std::shared_ptr<BodyForce> f) {
   forces_valid_ = false;
 }
 
-// World positions of the discs of body b from its pose.
 // The pair kernel's copy of disc i: centre, radius and body mass; velocity of the disc centre.
 inline void Simulation::pack_disc(int i) {
   const int b = d_.body[i];
@@ -230,6 +229,7 @@ inline void Simulation::pack_disc(int i) {
   pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
 }
 
+// World positions of the discs of body b from its pose.
 inline void Simulation::place_body(std::size_t b) {
   const int first = b_.first_disc[b], nd = b_.n_discs[b];
   const double X = b_.x[b], Y = b_.y[b];
@@ -477,9 +477,10 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
   nc_out = nc;
 }
 
-// Pair forces, wall forces and their sum per body, in one parallel region: pack the discs,
-// run the pair kernel on each thread's rows, reduce the thread buffers per disc and add the
-// wall forces of that disc, then sum per body (and, with kick_h > 0, kick it: step()).
+// Pair forces, wall forces and their sum per body, in one parallel region: pack the discs
+// (unless step() has), run the pair kernel on each thread's rows, reduce the thread buffers per
+// disc and add the wall forces of that disc, then sum per body (and, with kick_h > 0, kick it:
+// step()).
 void Simulation::contact_forces(double kick_h, bool packed) {
   const int n = static_cast<int>(d_.x.size());
   const int nb = static_cast<int>(b_.x.size());
