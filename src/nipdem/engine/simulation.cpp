@@ -579,45 +579,50 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     // same share as the body, so no barrier is needed between the discs and the bodies.
     const int bl = static_cast<int>(static_cast<std::int64_t>(nb) * t / team_size);
     const int bh = static_cast<int>(static_cast<std::int64_t>(nb) * (t + 1) / team_size);
-    const int k0 = bl < nb ? b_.first_disc[bl] : n, k1 = bh < nb ? b_.first_disc[bh] : n;
-    for (int i = k0; i < k1; ++i) {
-      double a = 0, b = 0, c = 0, p = 0, q = 0;
-      for (int u = 0; u < nt; ++u) {
-        if (i < split_[u] || i >= reach_hi_[u]) continue;
-        PackedForce& g = tforce_[u][i];
-        a += g.fx; b += g.fy; c += g.tq;
-        g = PackedForce{0.0, 0.0, 0.0, 0.0};
-        if (adh) {
-          double* h = &tadh_[u][2 * i];
-          p += h[0]; q += h[1];
-          h[0] = 0.0; h[1] = 0.0;
+    // In blocks of bodies, so that a block's disc sums are still in L1 when its bodies read them.
+    constexpr int kBlock = 256;
+    double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
+    const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
+    for (int c0 = bl; c0 < bh; c0 += kBlock) {
+      const int c1 = std::min(bh, c0 + kBlock);
+      const int k0 = b_.first_disc[c0], k1 = c1 < nb ? b_.first_disc[c1] : n;
+      for (int i = k0; i < k1; ++i) {
+        double a = 0, b = 0, c = 0, p = 0, q = 0;
+        for (int u = 0; u < nt; ++u) {
+          if (i < split_[u] || i >= reach_hi_[u]) continue;
+          PackedForce& g = tforce_[u][i];
+          a += g.fx; b += g.fy; c += g.tq;
+          g = PackedForce{0.0, 0.0, 0.0, 0.0};
+          if (adh) {
+            double* h = &tadh_[u][2 * i];
+            p += h[0]; q += h[1];
+            h[0] = 0.0; h[1] = 0.0;
+          }
+        }
+        d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
+        // Walls: the candidates of the list build, or while the sublist is in use only those
+        // within reach + margin when it was taken (most discs: none, no call).
+        const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];
+        if (wm != 0) {
+          try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
+            wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t], wall_nc);
+            if (take_near) wall_near_[i] = walls_near(static_cast<std::size_t>(i), margin, thread_hits_[t]);
+          } catch (...) {
+            if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
+          }
         }
       }
-      d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
-      // Walls: the candidates of the list build, or while the sublist is in use only those
-      // within reach + margin when it was taken (most discs: none, no call).
-      const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];
-      if (wm != 0) {
-        try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
-          wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t], wall_nc);
-          if (take_near) wall_near_[i] = walls_near(static_cast<std::size_t>(i), margin, thread_hits_[t]);
-        } catch (...) {
-          if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
+      if (kick_h > 0.0) {
+        // The same operations as step()'s own kick loop, so the same bits.
+        for (int bb = c0; bb < c1; ++bb) {
+          reduce_body(static_cast<std::size_t>(bb));
+          vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
         }
+      } else {
+        for (int bb = c0; bb < c1; ++bb) reduce_body(static_cast<std::size_t>(bb));
       }
     }
     thread_nc_[t] += wall_nc;
-    if (kick_h > 0.0) {
-      // The same operations as step()'s own kick loop, so the same bits.
-      double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
-      const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
-      for (int bb = bl; bb < bh; ++bb) {
-        reduce_body(static_cast<std::size_t>(bb));
-        vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
-      }
-    } else {
-      for (int bb = bl; bb < bh; ++bb) reduce_body(static_cast<std::size_t>(bb));
-    }
   }
   if (has_walls)
     for (const auto& e : thread_fail_)
@@ -834,29 +839,36 @@ void Simulation::step() {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
   const std::size_t team_size = static_cast<std::size_t>(omp_get_num_threads());
   const std::size_t b0 = nb * t / team_size, b1 = nb * (t + 1) / team_size;
-  detail::drift_bodies(drift, b0, b1, arrays);
-  double d1 = 0.0, d2 = 0.0;
-  for (std::size_t b = b0; b < b1; ++b) {
-    if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
-    place_body(b);
-    if (check_moves) {
-      const int first = b_.first_disc[b], nd = b_.n_discs[b];
-      for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
+  // In blocks of bodies small enough that what the drift wrote is still in L1 when the discs
+  // are placed, checked and packed (one pass over memory per step instead of three).
+  constexpr std::size_t kBlock = 256;
+  double d1 = 0.0, d2 = 0.0, s1 = 0.0;
+  for (std::size_t c0 = b0; c0 < b1; c0 += kBlock) {
+    const std::size_t c1 = std::min(b1, c0 + kBlock);
+    detail::drift_bodies(drift, c0, c1, arrays);
+    for (std::size_t b = c0; b < c1; ++b) {
+      if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
+      place_body(b);
+      if (check_moves) {
+        const int first = b_.first_disc[b], nd = b_.n_discs[b];
+        for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
+      }
     }
+    // The block's discs (contiguous: bodies own consecutive discs): the sublist's largest
+    // displacement, in a loop without branches, and the pair kernel's copy of them, which
+    // contact_forces() then need not make in a pass (and a barrier) of its own.
+    const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[c0]);
+    const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[c1 - 1] + b_.n_discs[c1 - 1]);
+    if (check_sub) {
+      const double m = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0, k1,
+                                                 periodic, params_.x_hi - params_.x_lo);
+      s1 = m > s1 || m != m ? m : s1;  // (NaN wins)
+    }
+    for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
   }
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;
-  // This thread's discs (contiguous: bodies own consecutive discs): the sublist's largest
-  // displacement, in a loop without branches, and the pair kernel's copy of them, which
-  // contact_forces() then need not make in a pass (and a barrier) of its own.
-  if (b1 > b0) {
-    const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[b0]);
-    const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[b1 - 1] + b_.n_discs[b1 - 1]);
-    if (check_sub)
-      thread_disp_[4 * t + 2] = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0,
-                                                          k1, periodic, params_.x_hi - params_.x_lo);
-    for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
-  }
+  thread_disp_[4 * t + 2] = s1;
   }
   int moved = 0;
   if (check_moves) {

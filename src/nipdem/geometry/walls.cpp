@@ -45,6 +45,7 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   double s = phi * radius - phase;
   s = std::fmod(s, circumference);
   if (s < 0) s += circumference;
+  if (s != s) return;  // a NaN centre touches nothing (and k0 below must be a number)
   const int k0 = static_cast<int>(std::floor(s / P));
   const int m = static_cast<int>(profile.size()) - 1;  // segments per period
   // Only the periods whose features can lie within a = r + reach of the centre: a feature at
@@ -115,7 +116,11 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   }
   for (int dk = -1; dk <= 1; ++dk) {
     if ((dk == -1 && !need_prev) || (dk == 1 && !need_next)) continue;
-    const int k = ((k0 + dk) % n_periods + n_periods) % n_periods;
+    // k0 + dk lies in [-1, n_periods + 1] (s in [0, circumference], k0 = floor(s / P)): wrapped
+    // by one add or subtract instead of two integer divisions
+    int k = k0 + dk;
+    k = k < 0 ? k + n_periods : k;
+    k = k >= n_periods ? k - n_periods : k;
     if (prepared) {
       Vec2 u;  // (cos, sin) of the polar angle of period k's s = 0 (no trigonometry when prepare_angle() saw this angle)
       if (fast_angle) {
