@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "nipdem/core/constants.hpp"
@@ -101,7 +102,9 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
       hits.push_back({static_cast<std::int64_t>(k) * 2 * m + m + j, v, to_world(dq / dd), gap, cross(omega, v - centre)});
     }
   };
-  const bool prepared = fast && prepared_profile_ == profile;
+  // (bitwise equal: the tables were made from this very profile; cheaper than comparing doubles)
+  const bool prepared = fast && prepared_profile_.size() == profile.size() &&
+                        std::memcmp(prepared_profile_.data(), profile.data(), profile.size() * sizeof(Vec2)) == 0;
   // Direct path (no prepared tables): each period's vertices by trigonometry, in the world frame
   // relative to the centre (u = identity). Scratch grows once per thread.
   thread_local std::vector<Vec2> vert, edge;

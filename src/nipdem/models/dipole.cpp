@@ -193,25 +193,30 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
     const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
     const int ii = static_cast<int>(i);
     const double xi = x[i], yi = y[i];
-    cand_.clear();
+    // Each candidate is written and the count moves on only if it is kept: no branch on the
+    // owner or distance test (outcomes a predictor cannot learn).
+    int m = 0;
     for (int oy = std::max(0, cy - 2); oy <= std::min(ny - 1, cy + 2); ++oy) {
       // the cells ox = cx-2 .. cx+2 of one grid row are consecutive: one run of particles
       const std::size_t c0 = static_cast<std::size_t>(oy) * nx + std::max(0, cx - 2);
       const std::size_t c1 = static_cast<std::size_t>(oy) * nx + std::min(nx - 1, cx + 2) + 1;
-      for (int k = cell_start_[c0], k1 = cell_start_[c1]; k < k1; ++k) {
+      const int k0 = cell_start_[c0], k1 = cell_start_[c1];
+      if (cand_.size() < static_cast<std::size_t>(m + (k1 - k0))) cand_.resize(2 * static_cast<std::size_t>(m + (k1 - k0)));
+      int* out = cand_.data();
+      for (int k = k0; k < k1; ++k) {
         const Binned& q = binned_[static_cast<std::size_t>(k)];
         const int j = q.index;
-        if (j == ii) continue;
         // owner of the pair (a < b): a if a + b is even, else b
         const int a = std::min(ii, j), bb = std::max(ii, j);
-        if ((((a + bb) & 1) == 0 ? a : bb) != ii) continue;
+        const int owner = ((a + bb) & 1) == 0 ? a : bb;
         const double dx = xi - q.x, dy = yi - q.y;
-        if (dx * dx + dy * dy < reach2) cand_.push_back(j);
+        out[m] = j;
+        m += static_cast<int>((j != ii) & (owner == ii) & (dx * dx + dy * dy < reach2));
       }
     }
-    std::sort(cand_.begin(), cand_.end());
-    nbr_.insert(nbr_.end(), cand_.begin(), cand_.end());
-    max_row_ = std::max(max_row_, static_cast<int>(cand_.size()));
+    std::sort(cand_.begin(), cand_.begin() + m);
+    nbr_.insert(nbr_.end(), cand_.begin(), cand_.begin() + m);
+    max_row_ = std::max(max_row_, m);
   }
   row_start_[n] = static_cast<int>(nbr_.size());
   x0_.assign(x.begin(), x.end());
