@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "nipdem/core/rng.hpp"
@@ -118,4 +119,62 @@ TEST(WallQuery, FindsEveryFeatureWithinReachOfAllPeriods) {
   }
   EXPECT_GT(hits_total, 300);
   EXPECT_GT(two_period, 5);  // discs straddling a period boundary are in the sample
+}
+
+// The period hint (engine-kept per disc) only saves the atan2: for any hint (right, a neighbour,
+// stale, out of range), the hits are the same, bit for bit and in the same order, as without it,
+// and the hint is left naming a period the centre lies in, so that the next query takes the fast path.
+TEST(WallQuery, PeriodHintNeverChangesTheHits) {
+  geometry::Wall w;
+  w.kind = geometry::Wall::Kind::cylinder;
+  w.name = "roller";
+  w.centre = {1e-4, -0.02};
+  w.radius = 0.02;
+  w.omega = 25.0;
+  geometry::set_pyramid_roughness(w, 15e-6, 50e-6, 20e-6);
+  Rng rng(11);
+  int hits_total = 0, fast_hits = 0;
+  for (double angle : {0.0, 0.3, -2.1, 1e3}) {
+    w.angle = angle;
+    w.prepare_angle();
+    for (int i = 0; i < 3000; ++i) {
+      // near period boundaries half of the time (where the hint and atan2 may disagree by one period)
+      const double P = w.period();
+      const int k = static_cast<int>(rng.uniform(0.0, w.n_periods));
+      const double s = (i % 2 == 0) ? k * P + rng.uniform(-1e-12, 1e-12) : rng.uniform(0.0, P * w.n_periods);
+      const double phi = (s + w.phase) / w.radius + angle;
+      const double rr = w.radius + rng.uniform(-20e-6, 20e-6);
+      const Vec2 c = w.centre + Vec2{rr * std::cos(phi), rr * std::sin(phi)};
+      const double r = rng.uniform(2e-6, 8e-6), reach = rng.uniform(0.0, 1e-6);
+      std::vector<geometry::WallHit> plain;
+      w.query(c, r, reach, plain);
+      int learned = -1;  // as the engine's first query: learns the period
+      std::vector<geometry::WallHit> first;
+      w.query(c, r, reach, first, &learned);
+      if (learned < 0) {  // out of reach of the base circle: refused before any period is looked for
+        ASSERT_TRUE(plain.empty());
+        continue;
+      }
+      ASSERT_LT(learned, w.n_periods);
+      for (int hint : {learned, learned, learned - 1, learned + 1, (learned + w.n_periods / 2) % w.n_periods, -5,
+                       w.n_periods, 1 << 30}) {
+        std::vector<geometry::WallHit> got;
+        int h = hint;
+        w.query(c, r, reach, got, &h);
+        ASSERT_EQ(got.size(), plain.size());
+        for (std::size_t q = 0; q < got.size(); ++q) {
+          EXPECT_EQ(got[q].key, plain[q].key);
+          // bit for bit: the same operations on the same numbers
+          EXPECT_EQ(std::memcmp(&got[q], &plain[q], sizeof(geometry::WallHit)), 0);
+        }
+        if (hint == learned) fast_hits += static_cast<int>(got.size());
+        EXPECT_GE(h, 0);
+        EXPECT_LT(h, w.n_periods);
+      }
+      ASSERT_EQ(first.size(), plain.size());
+      hits_total += static_cast<int>(plain.size());
+    }
+  }
+  EXPECT_GT(hits_total, 1000);  // the sample does exercise contacts
+  EXPECT_GT(fast_hits, 1000);   // and the hint's fast path
 }

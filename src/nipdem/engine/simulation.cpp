@@ -508,6 +508,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
       if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
   thread_nc_.assign(nt, 0);
   if (has_walls) thread_fail_.assign(nt, nullptr);
+  // per disc and wall: the roller period the disc was last found in (a hint for the query,
+  // which checks it; stale after renumbering, never wrong)
+  if (has_walls && wall_hint_.size() != static_cast<std::size_t>(n) * walls_.size())
+    wall_hint_.assign(static_cast<std::size_t>(n) * walls_.size(), -1);
   // The per-step sublist: used while it was taken from this list build, thread split, reach and
   // margin and no two discs can have closed the margin since; taken again otherwise.
   const double margin = params_.inner_skin_fraction * params_.skin;
@@ -658,7 +662,7 @@ bool Simulation::walls_within_margin() const {
 }
 
 // The walls of disc i's candidates within reach + margin of it now (one bit per wall).
-std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) const {
+std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) {
   const std::uint32_t mask = wall_mask_[i];
   const Vec2 c{d_.x[i], d_.y[i]};
   const double r = d_.r[i];
@@ -668,7 +672,7 @@ std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<g
     const double reach = wall_reach_[w] + margin;
     if (!walls_[w].may_touch(c, r, reach)) continue;
     hits.clear();
-    walls_[w].query(c, r, reach, hits);
+    walls_[w].query(c, r, reach, hits, &wall_hint_[i * walls_.size() + w]);
     if (!hits.empty()) near |= std::uint32_t{1} << w;
   }
   return near;
@@ -713,7 +717,7 @@ void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geomet
     if (!wall.may_touch(c, r, wall_reach_[w])) continue;  // most discs: no trigonometry, no query
     const Interaction& ia = params_.interactions[wall.interaction];
     hits.clear();
-    wall.query(c, r, wall_reach_[w], hits);
+    wall.query(c, r, wall_reach_[w], hits, &wall_hint_[i * nw + w]);
     const int bi = d_.body[i];
     for (const auto& h : hits) {
       touched = true;

@@ -186,7 +186,7 @@ class Simulation {
   void contact_forces(double kick_h = 0.0, bool packed = false);
   void prepare_walls();
   void wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
-  std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits) const;
+  std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits);  // (updates wall_hint_)
   bool walls_within_margin() const;
   void reduce_body(std::size_t b);
   void provider_forces();
@@ -241,6 +241,7 @@ class Simulation {
   std::vector<double> wall_reach_;                          // adhesion reach of each wall [m]
   std::vector<std::uint32_t> wall_mask_;                    // per disc: walls it may touch until the next list build
   std::vector<WallShape> wall_shape_;                       // wall shapes the masks were built for
+  std::vector<int> wall_hint_;                              // per disc and wall: period hint for Wall::query
   double time_ = 0.0;
   std::int64_t step_ = 0;
   std::int64_t next_id_ = 0;

@@ -19,7 +19,7 @@ Vec2 Wall::profile_point(int k, Vec2 sd) const {
   return centre + Vec2{rr * std::cos(phi), rr * std::sin(phi)};
 }
 
-void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const {
+void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits, int* hint) const {
   if (kind == Kind::plane) {
     const double dist = dot(c - point, normal);
     const double gap = dist - r;
@@ -41,34 +41,57 @@ void Wall::query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) con
   // Rough cylinder (discs outside). Quick reject on the base circle.
   if (dist - radius - r > reach) return;
   const double P = period();
-  const double circumference = P * n_periods;
-  double phi = std::atan2(d.y, d.x) - angle;
-  double s = phi * radius - phase;
-  s = std::fmod(s, circumference);
-  if (s < 0) s += circumference;
-  if (s != s) return;  // a NaN centre touches nothing (and k0 below must be a number)
-  const int k0 = static_cast<int>(std::floor(s / P));
   const int m = static_cast<int>(profile.size()) - 1;  // segments per period
+  const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P &&
+                    prepared_phase_ == phase && static_cast<int>(period_units_.size()) == n_periods;
+  const bool fast_angle = fast && prepared_angle_ == angle;
   // Only the periods whose features can lie within a = r + reach of the centre: a feature at
   // distance rho >= rho_min from the axis and polar angle dphi from the centre's is at least
   // 2 sqrt(dist rho) sin(|dphi|/2) away, so |dphi| <= 2 asin(x) <= 2 x (1 + x^2) with
   // x = a / (2 sqrt(dist rho_min)), x <= 1/2. rho_min = radius - max depth - P also covers
   // the chords between vertices. Period k0 - 1 ends (and k0 + 1 begins) at arc length
   // k0 P (and (k0 + 1) P); skipping a period that cannot touch changes no result.
-  const double s_in = s - k0 * P;
-  bool need_prev = true, need_next = true;
   const double rho_min = radius - max_depth_ - P;
+  double w = -1.0;  // (w < 0: look at all three periods)
   if (rho_min > 0.0) {
     const double x = (r + reach) / (2.0 * std::sqrt(dist * rho_min));
-    if (x <= 0.5) {
-      const double w = radius * 2.0 * x * (1.0 + x * x) * (1.0 + 1e-9) + 1e-12 * P;
-      need_prev = s_in <= w;
-      need_next = P - s_in <= w;
+    if (x <= 0.5) w = radius * 2.0 * x * (1.0 + x * x) * (1.0 + 1e-9) + 1e-12 * P;
+  }
+  // The period k0 the centre lies in, and bounds s_lo <= s_in <= s_hi on its arc position within
+  // it. With a hint (the period found for this disc last time, engine-kept) that still holds,
+  // by two cross products: no atan2, fmod or division. Then the test below looks at the same
+  // periods or more, where the periods' reach is under half a period (w < P / 2): the same hits,
+  // in the same order, as without the hint (a period that cannot touch adds none).
+  int k0 = -1;
+  double s_lo = 0.0, s_hi = 0.0;
+  const double theta_p = P / radius;  // a period's angle
+  if (hint && fast_angle && w >= 0.0 && w < 0.5 * P && theta_p <= 0.1 && *hint >= 0 && *hint < n_periods) {
+    const int k = *hint, kn = k + 1 == n_periods ? 0 : k + 1;
+    const Vec2 a = angle_rotation_, q0 = period_units_[k], q1 = period_units_[kn];
+    const Vec2 u0{a.x * q0.x - a.y * q0.y, a.x * q0.y + a.y * q0.x}, u1{a.x * q1.x - a.y * q1.y, a.x * q1.y + a.y * q1.x};
+    const double c0 = cross(u0, d), c1 = cross(d, u1);
+    if (c0 >= 0.0 && c1 > 0.0 && dot(u0, d) > 0.0) {
+      // s_in = radius theta with sin theta = c0 / dist, 0 <= theta <= theta_p (+ rounding):
+      // sin theta <= theta <= sin theta (1 + theta_p^2)
+      const double sr = radius * (c0 / dist);
+      s_lo = sr - 1e-12 * P;
+      s_hi = sr * (1.0 + theta_p * theta_p) + 1e-12 * P;
+      k0 = k;
     }
   }
-  const bool fast = unit_offsets_.size() == profile.size() && prepared_radius_ == radius && prepared_period_ == P &&
-                    prepared_phase_ == phase && static_cast<int>(period_units_.size()) == n_periods;
-  const bool fast_angle = fast && prepared_angle_ == angle;
+  if (k0 < 0) {
+    const double circumference = P * n_periods;
+    double phi = std::atan2(d.y, d.x) - angle;
+    double s = phi * radius - phase;
+    s = std::fmod(s, circumference);
+    if (s < 0) s += circumference;
+    if (s != s) return;  // a NaN centre touches nothing (and k0 below must be a number)
+    k0 = static_cast<int>(std::floor(s / P));
+    s_lo = s_hi = s - k0 * P;
+    if (hint) *hint = k0 < n_periods ? k0 : k0 - n_periods;
+  }
+  const bool need_prev = w < 0.0 || s_lo <= w;
+  const bool need_next = w < 0.0 || P - s_hi <= w;
   const double lim = r + reach;
   // One period in its own frame (period start on +x, origin at the centre): the centre cl, the
   // vertices, segment vectors, 1/|segment|^2 and convexity; u turns that frame into the world.

@@ -52,8 +52,10 @@ struct Wall {
 
   double period() const;
   bool rough() const { return !profile.empty(); }
-  // Appends all features within `reach` of a disc (centre c, radius r) to hits.
-  void query(Vec2 c, double r, double reach, std::vector<WallHit>& hits) const;
+  // Appends all features within `reach` of a disc (centre c, radius r) to hits. On a rough
+  // cylinder, `hint` (optional) is the caller's memory of the disc's period: tried first, then
+  // updated if it no longer holds; the hits do not depend on it (tests/unit/test_walls.cpp).
+  void query(Vec2 c, double r, double reach, std::vector<WallHit>& hits, int* hint = nullptr) const;
   // Cheap conservative pre-test (inline, no trigonometry): false only if query() would find
   // nothing. The engine calls it for every disc and wall each step, query() only if true.
   bool may_touch(Vec2 c, double r, double reach) const {
