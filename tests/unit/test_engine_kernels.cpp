@@ -1,7 +1,7 @@
-// The engine's vectorised kernels (engine/kernels.hpp) against the scalar law they evaluate:
-// the contact law on a batch of pairs must give, lane by lane and bit for bit, what
-// models::contact_force gives for that pair (thesis eqs. 2.2.5, 2.2.9-2.2.11, 2.3.2), whatever
-// clone (AVX-512, AVX2, generic) the machine picks; the body drift must be velocity Verlet's
+// The engine's kernels (engine/kernels.hpp) against what they evaluate: the pair loop's contact
+// of one disc pair must give, bit for bit, what models::contact_force gives for that pair with
+// the contact geometry written out plainly (thesis eqs. 2.2.5, 2.2.9-2.2.11, 2.3.2); the body
+// drift, whatever clone (AVX-512, AVX2, generic) the machine picks, must be velocity Verlet's
 // half-kick and drift (or Newmark explicit, eq. 4.2.17) exactly, and its rotation must keep
 // (cos, sin) a unit vector that follows the accumulated angle.
 #include <gtest/gtest.h>
@@ -28,12 +28,13 @@ namespace {
 }
 
 struct Disc { double x, y, r, m, vx, vy, w; };
+struct Pair { Disc a, c; double dx, dy, eta, slide; };
 
-// A batch of n pairs with every case the law distinguishes: overlapping (sticking, sliding,
-// about to slide), in adhesion range, beyond it, and history carried or empty.
-void fill(std::mt19937_64& rng, int n, std::vector<Disc>& discs, PairBatch& b) {
+// n pairs with every case the law distinguishes: overlapping (sticking, sliding, about to
+// slide), in adhesion range, beyond it, and history carried or empty.
+std::vector<Pair> make_pairs(std::mt19937_64& rng, int n) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  discs.clear();
+  std::vector<Pair> out;
   for (int k = 0; k < n; ++k) {
     const double ri = 3e-6 + 4e-6 * u(rng), rj = 3e-6 + 4e-6 * u(rng);
     // surface gap: overlapping by up to 40 nm (half the pairs), within the 4 nm adhesion
@@ -44,24 +45,16 @@ void fill(std::mt19937_64& rng, int n, std::vector<Disc>& discs, PairBatch& b) {
     Disc a{1e-4 * u(rng), 1e-4 * u(rng), ri, 1e-12 * (0.5 + u(rng)), u(rng) - 0.5, u(rng) - 0.5, 1e5 * (u(rng) - 0.5)};
     Disc c{a.x - dist * std::cos(phi), a.y - dist * std::sin(phi), rj, 1e-12 * (0.5 + u(rng)), u(rng) - 0.5,
            u(rng) - 0.5, 1e5 * (u(rng) - 0.5)};
-    discs.push_back(a);
-    discs.push_back(c);
-    b.dx[k] = a.x - c.x;
-    b.dy[k] = a.y - c.y;
-    b.e[k] = k;
-    b.i[k] = 2 * k;
-    b.j[k] = 2 * k + 1;
-    b.ri[k] = a.r; b.rj[k] = c.r; b.mi[k] = a.m; b.mj[k] = c.m;
-    b.vix[k] = a.vx; b.viy[k] = a.vy; b.wi[k] = a.w;
-    b.vjx[k] = c.vx; b.vjy[k] = c.vy; b.wj[k] = c.w;
     const double h = u(rng);
-    b.eta[k] = h < 0.3 ? 0.0 : 2e-7 * (u(rng) - 0.5);  // empty, or a stretch near the Coulomb cap
-    b.slide[k] = u(rng) < 0.3 ? 1.0 : 0.0;
+    const double eta = h < 0.3 ? 0.0 : 2e-7 * (u(rng) - 0.5);  // empty, or a stretch near the Coulomb cap
+    const double slide = u(rng) < 0.3 ? 1.0 : 0.0;
+    out.push_back({a, c, a.x - c.x, a.y - c.y, eta, slide});
   }
+  return out;
 }
 
-// The scalar pair kernel's geometry and law for one pair (what the engine computed before the
-// batch existed), for the lane k of b before compute_pair_batch ran.
+// The pair's geometry and law written out plainly, with branches (what the engine computed
+// before its pair kernel was rewritten for speed).
 struct Expect { double fx, fy, ti, tj, fax, fay, eta, slide, touching; };
 Expect scalar_pair(const models::ContactParams& cp, const models::HamakerParams& hp, bool adhesion, double dt,
                    const Disc& pi, const Disc& pj, double dx, double dy, double eta, double slide) {
@@ -101,71 +94,75 @@ Expect scalar_pair(const models::ContactParams& cp, const models::HamakerParams&
   return x;
 }
 
-void check_batch(bool adhesion, bool mass_prop, int n) {
+Expect engine_pair(const models::ContactParams& cp, const models::HamakerParams& hp, bool adhesion, double dt,
+                   const Pair& p) {
+  Expect x{};
+  x.eta = p.eta;
+  x.slide = p.slide;
+  const Disc &a = p.a, &c = p.c;
+  if (adhesion)
+    pair_contact<true>(cp, hp, dt, p.dx, p.dy, a.r, c.r, a.m, c.m, a.vx, a.vy, a.w, c.vx, c.vy, c.w, x.eta, x.slide, x.fx,
+                       x.fy, x.ti, x.tj, x.fax, x.fay, x.touching);
+  else
+    pair_contact<false>(cp, hp, dt, p.dx, p.dy, a.r, c.r, a.m, c.m, a.vx, a.vy, a.w, c.vx, c.vy, c.w, x.eta, x.slide, x.fx,
+                        x.fy, x.ti, x.tj, x.fax, x.fay, x.touching);
+  return x;
+}
+
+void check_pairs(bool adhesion, bool mass_prop, int n) {
   models::ContactParams cp{.k = 50.0, .gamma = 3e-5, .ks = 100.0 / 7.0, .mu_s = 0.5, .mu_d = 0.3};
   if (mass_prop) { cp.gamma = 2e6; cp.gamma_t = 1e6; cp.mass_proportional = true; }
   const models::HamakerParams hp{.hamaker_J = 1e-19, .min_separation_m = 4e-10, .cutoff_m = 4e-9};
   const double dt = 2e-9;
   std::mt19937_64 rng(1234 + n + 2 * adhesion + mass_prop);
-  std::vector<Disc> discs;
-  PairBatch b;
-  fill(rng, n, discs, b);
-  std::vector<Expect> want;
+  const std::vector<Pair> pairs = make_pairs(rng, n);
   int touching = 0, sliding = 0, in_range = 0;
   for (int k = 0; k < n; ++k) {
-    want.push_back(scalar_pair(cp, hp, adhesion, dt, discs[2 * k], discs[2 * k + 1], b.dx[k], b.dy[k], b.eta[k],
-                               b.slide[k]));
-    touching += want.back().touching != 0.0;
-    sliding += want.back().slide != 0.0;
-    in_range += want.back().fax != 0.0 || want.back().fay != 0.0;
+    SCOPED_TRACE("pair " + std::to_string(k));
+    const Pair& p = pairs[k];
+    const Expect want = scalar_pair(cp, hp, adhesion, dt, p.a, p.c, p.dx, p.dy, p.eta, p.slide);
+    touching += want.touching != 0.0;
+    sliding += want.slide != 0.0;
+    in_range += want.fax != 0.0 || want.fay != 0.0;
+    const Expect got = engine_pair(cp, hp, adhesion, dt, p);
+    EXPECT_TRUE(same_bits(got.fx, want.fx));
+    EXPECT_TRUE(same_bits(got.fy, want.fy));
+    EXPECT_TRUE(same_bits(got.ti, want.ti));
+    EXPECT_TRUE(same_bits(got.tj, want.tj));
+    EXPECT_TRUE(same_bits(got.eta, want.eta));
+    EXPECT_TRUE(same_bits(got.slide, want.slide));
+    EXPECT_TRUE(same_bits(got.touching, want.touching));
+    if (adhesion) {
+      EXPECT_TRUE(same_bits(got.fax, want.fax));
+      EXPECT_TRUE(same_bits(got.fay, want.fay));
+    }
   }
-  // the batch covers the cases (else the comparison proves little)
+  // the sample covers the cases (else the comparison proves little)
   EXPECT_GT(touching, n / 4);
   EXPECT_GT(sliding, 0);
   EXPECT_LT(touching, n);
   if (adhesion) EXPECT_GT(in_range, touching);
-  compute_pair_batch(cp, hp, dt, adhesion, n, b);
-  for (int k = 0; k < n; ++k) {
-    SCOPED_TRACE("pair " + std::to_string(k));
-    EXPECT_TRUE(same_bits(b.fx[k], want[k].fx));
-    EXPECT_TRUE(same_bits(b.fy[k], want[k].fy));
-    EXPECT_TRUE(same_bits(b.ti[k], want[k].ti));
-    EXPECT_TRUE(same_bits(b.tj[k], want[k].tj));
-    EXPECT_TRUE(same_bits(b.eta[k], want[k].eta));
-    EXPECT_TRUE(same_bits(b.slide[k], want[k].slide));
-    EXPECT_TRUE(same_bits(b.touching[k], want[k].touching));
-    if (adhesion) {
-      EXPECT_TRUE(same_bits(b.fax[k], want[k].fax));
-      EXPECT_TRUE(same_bits(b.fay[k], want[k].fay));
-    }
-  }
 }
 
 }  // namespace
 
-TEST(EngineKernels, PairBatchIsTheScalarLawBitwise) {
-  for (const int n : {PairBatch::kN, 37}) {  // a full batch, and one with a vector remainder
-    check_batch(false, false, n);
-    check_batch(true, false, n);
-    check_batch(true, true, n);
-  }
+TEST(EngineKernels, PairContactIsTheScalarLawBitwise) {
+  check_pairs(false, false, 64);
+  check_pairs(true, false, 64);
+  check_pairs(true, true, 64);
 }
 
-TEST(EngineKernels, PairBatchOfOnePair) {
-  // The vector loop's remainder path alone: one overlapping pair.
+TEST(EngineKernels, PairContactOfTwoApproachingDiscs) {
   const models::ContactParams cp{.k = 50.0, .gamma = 3e-5, .ks = 100.0 / 7.0, .mu_s = 0.5, .mu_d = 0.3};
   const models::HamakerParams hp{};
   const Disc a{0, 0, 5e-6, 1e-12, -0.1, 0, 0}, c{-9.99e-6, 0, 5e-6, 1e-12, 0, 0, 0};  // approaching
-  PairBatch b;
-  b.dx[0] = a.x - c.x; b.dy[0] = a.y - c.y; b.i[0] = 0; b.j[0] = 1; b.e[0] = 0; b.eta[0] = 0.0; b.slide[0] = 0.0;
-  b.ri[0] = a.r; b.rj[0] = c.r; b.mi[0] = a.m; b.mj[0] = c.m;
-  b.vix[0] = a.vx; b.viy[0] = a.vy; b.wi[0] = a.w; b.vjx[0] = c.vx; b.vjy[0] = c.vy; b.wj[0] = c.w;
-  const Expect x = scalar_pair(cp, hp, false, 1e-9, a, c, b.dx[0], b.dy[0], 0.0, 0.0);
-  compute_pair_batch(cp, hp, 1e-9, false, 1, b);
-  EXPECT_EQ(b.touching[0], 1.0);
+  const Pair p{a, c, a.x - c.x, a.y - c.y, 0.0, 0.0};
+  const Expect x = scalar_pair(cp, hp, false, 1e-9, a, c, p.dx, p.dy, 0.0, 0.0);
+  const Expect got = engine_pair(cp, hp, false, 1e-9, p);
+  EXPECT_EQ(got.touching, 1.0);
   // overlap 10 nm, approaching at 0.1 m/s: k xi + gamma v = 0.5 N + 3e-6 N, along +x on i
-  EXPECT_NEAR(b.fx[0], 50.0 * 1e-8 + 3e-5 * 0.1, 1e-12);
-  EXPECT_TRUE(same_bits(b.fx[0], x.fx));
+  EXPECT_NEAR(got.fx, 50.0 * 1e-8 + 3e-5 * 0.1, 1e-12);
+  EXPECT_TRUE(same_bits(got.fx, x.fx));
 }
 
 TEST(EngineKernels, DriftIsVelocityVerletAndNewmarkExactly) {

@@ -1,21 +1,15 @@
-// The engine's arithmetic that runs on many items at once, in flat arrays, so that the compiler
-// evaluates several per instruction (docs/performance.md, "Batched pair kernel"): the contact
-// law on a batch of disc pairs, and the integration of the bodies.
+// The engine's arithmetic on many items at once, in flat arrays: the integration of the bodies,
+// compiled for AVX-512, AVX2 and generic x86-64 and picked at load time (GCC target_clones),
+// with identical results on every machine (no FMA contraction: src/CMakeLists.txt); and the
+// contact law of one disc pair as the engine's pair loop evaluates it (pair_contact).
 //
-// Pairs: the engine's pair_rows() finds the interacting pairs of its rows
-// (cheap distance tests), copies their data into a PairBatch, calls compute_pair_batch(), and
-// adds the results to the discs in list order.
-//
-// Why it is bitwise the scalar kernel: each lane does exactly the scalar operations, in the
-// same order, of models::contact_force (the one contact law); vector sqrt, divide, add and
-// multiply are correctly rounded like their scalar forms; there is no fused multiply-add (none
-// of the clones enables FMA); and the sums into the discs stay scalar and in list order.
-// The functions here are compiled for AVX-512, AVX2 and generic x86-64 and picked at load
-// time (GCC target_clones), with identical results on every machine (no FMA contraction:
-// src/CMakeLists.txt). GCC 12 vectorises drift_bodies in its clones but leaves the pair loop
-// scalar in every clone ("no vectype"); written out per target it vectorises and gains nothing
-// measurable, since the law is a small part of the pair kernel (docs/performance.md, fifth pass).
+// The pair loop (Simulation::pair_rows) evaluates each interacting pair where it finds it
+// (docs/performance.md, eleventh pass). Until then it collected the pairs into batches of 64
+// and ran the law on a batch at once, so that the compiler could evaluate several pairs per
+// instruction; GCC 12 left that loop scalar, and the stores and gathers of the batch cost more
+// than a predicted branch (packing 1.047x, nip 1.01-1.04x without them).
 #pragma once
+#include <cmath>
 #include <cstdint>
 
 #include "nipdem/models/contact.hpp"
@@ -23,23 +17,51 @@
 
 namespace nipdem::engine::detail {
 
-struct PairBatch {
-  static constexpr int kN = 64;
-  // inputs: i - j centre vector (minimum image), radii, body masses, disc-centre velocities and
-  // body spins of both discs, and the pair's tangential history (slide as 0/1)
-  alignas(64) double dx[kN], dy[kN], ri[kN], rj[kN], mi[kN], mj[kN];
-  alignas(64) double vix[kN], viy[kN], wi[kN], vjx[kN], vjy[kN], wj[kN];
-  alignas(64) double eta[kN], slide[kN];
-  // outputs: force on i (j gets its negative), torques about each centre, the adhesive part
-  // (its vector fax, fay on i), the history to store, and 1 where the discs overlap
-  alignas(64) double fx[kN], fy[kN], ti[kN], tj[kN], fax[kN], fay[kN], touching[kN];
-  // which pair: list entry and the two discs
-  int e[kN], i[kN], j[kN];
-};
-
-// Evaluates pairs [0, n) of b; `adhesion` adds the Hamaker term (hp is not read without it).
-void compute_pair_batch(const models::ContactParams& cp, const models::HamakerParams& hp, double dt, bool adhesion,
-                        int n, PairBatch& b);
+// One disc pair within contact or adhesion range (thesis eqs. 2.2.5, 2.2.9-2.2.11 and 2.3.2
+// through models::contact_force, the one contact law): the geometry of the contact, the law,
+// and the force and torques on both discs. In: dx, dy the i - j centre vector, radii,
+// body masses, disc-centre velocities v*, body spins w*; eta, slide the pair's tangential
+// history (updated in place, slide as 0/1). Out: the force on i (j gets its negative), the
+// torques about each centre, the adhesive part fax, fay of the force on i (written only with
+// adhesion), 1 if the discs overlap.
+template <bool kAdhesion>
+[[gnu::always_inline]] inline void pair_contact(const models::ContactParams& cp, const models::HamakerParams& hp,
+                                             double dt, double dx, double dy, double ri, double rj, double mi,
+                                             double mj, double vix, double viy, double wi, double vjx, double vjy,
+                                             double wj, double& eta, double& slide, double& fx_out, double& fy_out,
+                                             double& ti, double& tj, double& fax, double& fay, double& touching_out) {
+  const double d2 = dx * dx + dy * dy;
+  const double dist = std::sqrt(d2);
+  const double inv = 1.0 / dist;
+  const double nx = dx * inv, ny = dy * inv;  // from j to i
+  const double overlap = (ri + rj) - dist;
+  const bool touching = overlap > 0.0;
+  // centre to contact point, and the relative velocity of the contact points (read by the
+  // contact law only while the discs overlap)
+  const double li = ri - 0.5 * overlap, lj = rj - 0.5 * overlap;
+  const double vrx = (vix + wi * li * ny) - (vjx - wj * lj * ny);
+  const double vry = (viy - wi * li * nx) - (vjy + wj * lj * nx);
+  const double vn = touching ? vrx * nx + vry * ny : 0.0;
+  const double vt = touching ? -vrx * ny + vry * nx : 0.0;
+  const double mred = (touching && cp.mass_proportional) ? mi * mj / (mi + mj) : 0.0;
+  models::TangentialState st{eta, slide};
+  const models::ContactForce c = models::contact_force<kAdhesion>(cp, hp, ri, rj, overlap, vn, vt, mred, dt, st);
+  eta = st.eta;
+  slide = st.sliding;
+  double fx = touching ? c.fn * nx - c.ft * ny : 0.0;
+  double fy = touching ? c.fn * ny + c.ft * nx : 0.0;
+  ti = touching ? -li * c.ft : 0.0;
+  tj = touching ? -lj * c.ft : 0.0;
+  if constexpr (kAdhesion) {
+    fx -= c.fa * nx;
+    fy -= c.fa * ny;
+    fax = c.fa * nx;
+    fay = c.fa * ny;
+  }
+  fx_out = fx;
+  fy_out = fy;
+  touching_out = touching ? 1.0 : 0.0;
+}
 
 // Per-body arrays the integration reads and writes (the engine's BodyStore plus scratch).
 struct BodyArrays {

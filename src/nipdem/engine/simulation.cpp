@@ -367,15 +367,13 @@ void Simulation::update_thread_split() {
 
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
 // list and its history), accumulates force and torque about the disc centre into f and the
-// adhesive part into fa (2 per disc). In three passes over batches of interacting pairs
-// (engine/kernels.hpp): a distance test per list entry that collects the pairs within
-// contact or adhesion range with their centre vector (and clears the history of those out of
-// it); the contact law (models::contact_force) on the whole batch at once (one flat loop; GCC
-// 12 leaves it scalar, docs/performance.md fifth pass); then the sums into the discs,
-// scalar and in list order, the same additions in the same order as one loop over the list
-// would make (a row's own sum is accumulated apart and added when the row ends).
+// adhesive part into fa (2 per disc). One loop over the entries: a distance test, and for a
+// pair within contact or adhesion range the law at once (detail::pair_contact) and its sums
+// into both discs, in list order (a row's own sum is accumulated apart and added when the row
+// ends). The history of a pair out of range is cleared.
+// (Kept out of line: inlined into contact_forces' parallel region, GCC 12 made it ~3 % slower.)
 template <bool kAdhesion, bool kPeriodic, int kList>
-void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out, SubEntry* sub,
+[[gnu::noinline]] void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out, SubEntry* sub,
                            int& sub_n) {
   const ContactParams cp = params_.interactions[0].contact;
   const models::HamakerParams hp = params_.interactions[0].adhesion;
@@ -399,8 +397,6 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     }
     return Vec2{dx, dy};
   };
-  detail::PairBatch B;
-  int n = 0;
   std::int64_t nc = 0;
   // the row whose own sum is open, and that sum
   int row = -1;
@@ -411,38 +407,6 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     if constexpr (kAdhesion) { fa[2 * row] += faxi; fa[2 * row + 1] += fayi; }
     fxi = fyi = tqi = faxi = fayi = 0.0;
   };
-  auto flush = [&]() __attribute__((always_inline)) {
-    for (int k = 0; k < n; ++k) {  // gather what the law reads
-      const int i = B.i[k], j = B.j[k], e = B.e[k];
-      B.ri[k] = P[i].r; B.rj[k] = P[j].r; B.mi[k] = P[i].m; B.mj[k] = P[j].m;
-      B.vix[k] = V[i].vx; B.viy[k] = V[i].vy; B.wi[k] = V[i].w;
-      B.vjx[k] = V[j].vx; B.vjy[k] = V[j].vy; B.wj[k] = V[j].w;
-      B.eta[k] = eta[e]; B.slide[k] = sl[e];
-    }
-    detail::compute_pair_batch(cp, hp, dt, kAdhesion, n, B);
-    for (int k = 0; k < n; ++k) {  // sums, in list order
-      const int i = B.i[k], j = B.j[k], e = B.e[k];
-      if (i != row) { close_row(); row = i; }
-      eta[e] = B.eta[k]; sl[e] = static_cast<std::uint8_t>(B.slide[k]);
-      nc += static_cast<std::int64_t>(B.touching[k]);
-      const double fnx = B.fx[k], fny = B.fy[k];
-      fxi += fnx; fyi += fny; tqi += B.ti[k];
-      f[j].fx -= fnx; f[j].fy -= fny; f[j].tq += B.tj[k];
-      if constexpr (kAdhesion) {
-        faxi -= B.fax[k]; fayi -= B.fay[k];
-        fa[2 * j] += B.fax[k]; fa[2 * j + 1] += B.fay[k];
-      }
-    }
-    n = 0;
-  };
-  // One flat loop over the rows' entries, without a branch on the data: the test's outcome
-  // (about one entry in three interacts in a packing) and the row lengths (0-6) are what a
-  // branch predictor cannot learn. The entry, its two discs and their centre vector are always
-  // written to the batch (five stores to a buffer in L1); the count moves on only if the pair
-  // interacts. flush() then reads only what the law needs beyond that (radii, masses,
-  // velocities, history), for the pairs that interact: in a packing most listed pairs touch and
-  // the distance test's loads are not repeated (1.085x on bench_lammps_packing), in the nip most
-  // are apart and the extra stores cost little (1.03x on bench_nip).
   const double margin = sub_margin_;
   int m = 0;
   auto test = [&](int e, int i, int j) __attribute__((always_inline)) {
@@ -452,19 +416,34 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     const double rc = (pi.r + pj.r) + reach;
     const double d2 = d.x * d.x + d.y * d.y;
     const bool interacts = d2 < rc * rc;
-    B.e[n] = e; B.i[n] = i; B.j[n] = j; B.dx[n] = d.x; B.dy[n] = d.y;
-    n += interacts ? 1 : 0;
-    if constexpr (kList == 1) {  // taken into the sublist within range + margin (also branch-free)
+    if constexpr (kList == 1) {  // taken into the sublist within range + margin (branch-free)
       const double rm = rc + margin;
       sub[m] = {e, i, j};
       m += d2 < rm * rm ? 1 : 0;
     }
-    // History of a pair out of range is reset where there is some (rare: a contact that just
-    // opened); most stay clean, and a read keeps their cache lines clean (no write-back). A pair
-    // left out of the sublist is out of range when it is taken, so its history is clean then and
-    // stays so until the next sublist.
-    if ((!interacts) & ((sl[e] != 0) | (eta[e] != 0.0))) { eta[e] = 0.0; sl[e] = 0; }
-    if (n == detail::PairBatch::kN) flush();
+    if (interacts) {
+      const PackedVel& vi = V[i];
+      const PackedVel& vj = V[j];
+      double et = eta[e], sd = static_cast<double>(sl[e]);
+      double fx, fy, ti, tj, fax = 0.0, fay = 0.0, touching;
+      detail::pair_contact<kAdhesion>(cp, hp, dt, d.x, d.y, pi.r, pj.r, pi.m, pj.m, vi.vx, vi.vy, vi.w, vj.vx, vj.vy,
+                                      vj.w, et, sd, fx, fy, ti, tj, fax, fay, touching);
+      if (i != row) { close_row(); row = i; }
+      eta[e] = et; sl[e] = static_cast<std::uint8_t>(sd);
+      nc += static_cast<std::int64_t>(touching);
+      fxi += fx; fyi += fy; tqi += ti;
+      f[j].fx -= fx; f[j].fy -= fy; f[j].tq += tj;
+      if constexpr (kAdhesion) {
+        faxi -= fax; fayi -= fay;
+        fa[2 * j] += fax; fa[2 * j + 1] += fay;
+      }
+    } else if ((sl[e] != 0) | (eta[e] != 0.0)) {
+      // History of a pair out of range is reset where there is some (rare: a contact that just
+      // opened); most stay clean, and a read keeps their cache lines clean (no write-back). A
+      // pair left out of the sublist is out of range when it is taken, so its history is clean
+      // then and stays so until the next sublist.
+      eta[e] = 0.0; sl[e] = 0;
+    }
   };
   if constexpr (kList == 2) {
     for (int k = 0; k < sub_n; ++k) test(sub[k].e, sub[k].i, sub[k].j);
@@ -472,7 +451,6 @@ void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int6
     for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) test(e, own[e], nb[e]);
   }
   if constexpr (kList == 1) sub_n = m;
-  flush();
   close_row();
   nc_out = nc;
 }
