@@ -141,7 +141,9 @@ void check_pairs(bool adhesion, bool mass_prop, int n) {
   EXPECT_GT(touching, n / 4);
   EXPECT_GT(sliding, 0);
   EXPECT_LT(touching, n);
-  if (adhesion) EXPECT_GT(in_range, touching);
+  if (adhesion) {
+    EXPECT_GT(in_range, touching);
+  }
 }
 
 }  // namespace

@@ -31,8 +31,8 @@ struct ContactParams {
 // Per-contact history carried from step to step (eq. 2.2.11).
 struct TangentialState {
   double eta = 0.0;      // tangential spring stretch along the current tangent [m]
-  // 1 while the contact slides with dynamic friction, else 0; a double (not a bool) so that the
-  // engine's batched pair kernel selects on it with the same vector instructions as on eta.
+  // 1 while the contact slides with dynamic friction, else 0 (a double, selected on like eta:
+  // see tangential_force).
   double sliding = 0.0;
 };
 
@@ -65,8 +65,9 @@ inline double normal_force(const ContactParams& p, double overlap, double v_n, d
 //    i.e. when the slip stops or reverses.
 inline double tangential_force(const ContactParams& p, TangentialState& st, double v_t, double fn_load,
                                double dt, double m_red) {
-  // Both outcomes are computed and one is selected (no branch on the data): the engine's batched
-  // pair kernel evaluates this law for several contacts per instruction (engine/kernels.hpp).
+  // Both outcomes are computed and one is selected (no branch on the data): in the nip, where
+  // the outcome varies from pair to pair, branches were slower (0.981x on bench_nip, measured
+  // 2026-12-07: docs/performance.md, eleventh pass).
   const double gt = p.mass_proportional ? p.gamma_t * m_red : p.gamma_t;
   const double eta_trial = st.eta + v_t * dt;
   const double f_trial = -p.ks * eta_trial - gt * v_t;
@@ -97,7 +98,7 @@ template <bool kAdhesion>
 inline ContactForce contact_force(const ContactParams& cp, const HamakerParams& hp, double r1, double r2, double overlap,
                                   double v_n, double v_t, double m_red, double dt, TangentialState& st) {
   // Evaluated whether or not the surfaces overlap, then selected (no branch on the data, as in
-  // tangential_force).
+  // tangential_force, and for the same reason).
   const bool touching = overlap > 0.0;
   TangentialState s = st;
   const double fn = normal_force(cp, overlap, v_n, m_red);
