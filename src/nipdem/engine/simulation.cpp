@@ -373,8 +373,8 @@ void Simulation::update_thread_split() {
 // ends). The history of a pair out of range is cleared.
 // (Kept out of line: inlined into contact_forces' parallel region, GCC 12 made it ~3 % slower.)
 template <bool kAdhesion, bool kPeriodic, int kList>
-[[gnu::noinline]] void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out, SubEntry* sub,
-                           int& sub_n) {
+[[gnu::noinline]] void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out,
+                                             SubEntry* sub, int& sub_n) {
   const ContactParams cp = params_.interactions[0].contact;
   const models::HamakerParams hp = params_.interactions[0].adhesion;
   const double dt = params_.dt;
