@@ -13,13 +13,20 @@
 
 using namespace nipdem;
 
-TEST(WallQuery, PreparedRotationsEqualDirectTrigonometry) {
+// A 2 cm roller with the pyramid roughness of the presets' scale (prepared tables included).
+static geometry::Wall rough_roller(double omega = 0.0) {
   geometry::Wall w;
   w.kind = geometry::Wall::Kind::cylinder;
   w.name = "roller";
   w.centre = {1e-4, -0.02};
   w.radius = 0.02;
+  w.omega = omega;
   geometry::set_pyramid_roughness(w, 15e-6, 50e-6, 20e-6);  // prepares
+  return w;
+}
+
+TEST(WallQuery, PreparedRotationsEqualDirectTrigonometry) {
+  geometry::Wall w = rough_roller();
   geometry::Wall direct = w;
   direct.unit_offsets_.clear();  // forces the per-vertex trigonometry
   Rng rng(7);
@@ -125,13 +132,7 @@ TEST(WallQuery, FindsEveryFeatureWithinReachOfAllPeriods) {
 // stale, out of range), the hits are the same, bit for bit and in the same order, as without it,
 // and the hint is left naming a period the centre lies in, so that the next query takes the fast path.
 TEST(WallQuery, PeriodHintNeverChangesTheHits) {
-  geometry::Wall w;
-  w.kind = geometry::Wall::Kind::cylinder;
-  w.name = "roller";
-  w.centre = {1e-4, -0.02};
-  w.radius = 0.02;
-  w.omega = 25.0;
-  geometry::set_pyramid_roughness(w, 15e-6, 50e-6, 20e-6);
+  geometry::Wall w = rough_roller(25.0);
   Rng rng(11);
   int hits_total = 0, fast_hits = 0;
   for (double angle : {0.0, 0.3, -2.1, 1e3}) {
