@@ -16,6 +16,7 @@
 //                  [--state dense|loose] [--dense-file FILE] [--repeat R=1]
 //                  [--press-time S=2e-4] [--relax-steps N=4000] [--dipole-skin M (default magnet.dipole_skin_m, 8e-6)]
 //                  [--inner-skin F (EngineParams::inner_skin_fraction, speed only)]
+//                  [--skin-quantile Q (EngineParams::skin_speed_quantile, speed only; 0: one skin for all)]
 //                  [--sort-cell M (0: the state's own order)] [--set key=value ...]   (extra config overrides, as `nipdem run --set`)
 // --sort-cell M adds the start state's bodies in spatial order (strips M wide in x, by y within a
 // strip) instead of the order they were made in: what memory locality is worth (bench/README.md,
@@ -306,6 +307,7 @@ State make_dense_state(const std::vector<std::string>& base, double press_time, 
 double g_dipole_skin = -1;  // --dipole-skin: overrides magnet.dipole_skin_m
 int g_run_threads = 0;      // --run-threads: EngineParams::run_threads (0: the engine's measured choice)
 double g_inner_skin = -1;  // --inner-skin: EngineParams::inner_skin_fraction (speed only; <0: the engine's)
+double g_skin_quantile = -1;  // --skin-quantile: EngineParams::skin_speed_quantile (speed only; <0: the engine's)
 double g_sort_cell = 0;     // --sort-cell: strip width [m] of the start state's spatial order (0: file order)
 
 Result run(std::vector<std::string> overrides, const State* start, long settle, long steps, bool print_params) {
@@ -330,6 +332,7 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   }
   sim.mutable_params().run_threads = g_run_threads;  // checked against --threads in main()
   if (g_inner_skin >= 0) sim.mutable_params().inner_skin_fraction = g_inner_skin;
+  if (g_skin_quantile >= 0) sim.mutable_params().skin_speed_quantile = g_skin_quantile;
   const double dt = nip.time_step().dt;
   if (start) {  // the same bodies in the same order (contact history starts empty)
     const auto& tmpl = nip::find_template(cfg.templates, cfg.cluster, cfg.file, "toner.cluster");
@@ -433,7 +436,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> extra;
   bench::parse_args(argc, argv,
                     "bench_nip [--steps N] [--settle N] [--threads T] [--half-width M] [--state dense|loose] [--dense-file FILE] "
-                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--inner-skin F] [--sort-cell M] [--set key=value]",
+                    "[--repeat R] [--press-time S] [--relax-steps N] [--dipole-skin M] [--run-threads R] [--inner-skin F] [--skin-quantile Q] [--sort-cell M] [--set key=value]",
                     {{"--steps", [&](const std::string& v) { steps = nipdem::bench::at_least(nipdem::bench::to_long(v), 1L); }},
                      {"--settle", [&](const std::string& v) { settle = nipdem::bench::at_least(nipdem::bench::to_long(v), 0L); }},
                      {"--threads", [&](const std::string& v) { threads = nipdem::bench::at_least(nipdem::bench::to_int(v), 1); }},
@@ -447,6 +450,10 @@ int main(int argc, char** argv) {
                      {"--inner-skin", [&](const std::string& v) {
                         g_inner_skin = nipdem::bench::to_double(v);
                         if (!(g_inner_skin >= 0 && g_inner_skin <= 1)) throw std::invalid_argument("must be in [0, 1]");
+                      }},
+                     {"--skin-quantile", [&](const std::string& v) {
+                        g_skin_quantile = nipdem::bench::to_double(v);
+                        if (!(g_skin_quantile >= 0 && g_skin_quantile < 1)) throw std::invalid_argument("must be in [0, 1)");
                       }},
                      {"--sort-cell", [&](const std::string& v) {
                         g_sort_cell = nipdem::bench::to_double(v);

@@ -154,6 +154,117 @@ TEST(NeighborList, TwoLargestDisplacementCriterionNeverMissesAPair) {
   EXPECT_GT(rebuilds, 3);  // the walk does trigger rebuilds
 }
 
+// Skins per disc (NeighborList::rebuild's half_skin): the list holds exactly the pairs within
+// r_i + r_j + extra + h_i + h_j of each other (brute force over all pairs), also where a disc's
+// skin reaches beyond the 3 x 3 cells around it (one in ten discs, up to 8 times the others'),
+// periodic or not, and the same list for 1 and 3 threads. Random positions: no pair sits on
+// the boundary to rounding.
+TEST(NeighborList, SkinsPerDiscListExactlyThePairsWithinTheirReach) {
+  for (bool periodic : {false, true}) {
+    const test::DiscCloud d = test::random_discs(3000, 400e-6, 11, 3);
+    geometry::NeighborListParams p;
+    p.skin = 1e-6;
+    p.extra_range = 0.3e-6;
+    p.periodic_x = periodic;
+    p.x_lo = 0;
+    p.x_hi = 400e-6;
+    Rng rng(4);
+    std::vector<double> h(d.x.size(), 0.5e-6);
+    for (auto& v : h)
+      if (rng.uniform(0, 1) < 0.1) v = rng.uniform(0.5e-6, 4e-6);
+    std::vector<geometry::NeighborList> lists(2);
+    for (int t = 0; t < 2; ++t) {
+      p.threads = 1 + 2 * t;
+      lists[t].rebuild(d.x, d.y, d.r, d.body, {}, p, h);
+    }
+    EXPECT_EQ(lists[1].row_start_, lists[0].row_start_);
+    EXPECT_EQ(lists[1].nbr_, lists[0].nbr_);
+    EXPECT_GT(lists[0].wide_discs(), 100u);  // the wide search ran
+    std::set<std::pair<int, int>> want;
+    for (std::size_t i = 0; i < d.x.size(); ++i)
+      for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+        if (d.body[i] == d.body[j]) continue;
+        double dx = d.x[i] - d.x[j];
+        if (periodic) dx -= 400e-6 * std::nearbyint(dx / 400e-6);
+        const double dy = d.y[i] - d.y[j];
+        const double rc = d.r[i] + d.r[j] + p.extra_range + h[i] + h[j];
+        if (dx * dx + dy * dy < rc * rc) want.insert({static_cast<int>(i), static_cast<int>(j)});
+      }
+    EXPECT_EQ(listed(lists[0]), want) << (periodic ? "periodic" : "open");
+    // rows sorted, no repeats (the wide pairs merged into them)
+    for (std::size_t i = 0; i < lists[0].size(); ++i)
+      for (int k = lists[0].row_start_[i] + 1; k < lists[0].row_start_[i + 1]; ++k)
+        ASSERT_LT(lists[0].nbr_[k - 1], lists[0].nbr_[k]);
+  }
+}
+
+// The criterion with skins per disc: rebuilt when a disc has moved farther than its own skin
+// (track(), needs_rebuild()). Random walks where four discs move 20 times faster than the rest
+// and have skins 4 times wider: at every step every pair within the interaction range is
+// listed (brute force), and the list is rebuilt far less often than with one skin for all
+// (where the four fast discs set the pace).
+TEST(NeighborList, SkinsPerDiscCriterionNeverMissesAPair) {
+  auto walk = [](bool per_disc) {
+    test::DiscCloud d = test::random_discs(400, 150e-6, 9, 3);
+    geometry::NeighborListParams p;
+    p.skin = 1e-6;
+    p.extra_range = 0.2e-6;
+    std::vector<double> h;
+    if (per_disc) {
+      h.assign(d.x.size(), 0.5e-6);
+      for (int i = 0; i < 4; ++i) h[i] = 2e-6;
+    }
+    geometry::NeighborList nl;
+    nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h);
+    Rng rng(3);
+    int rebuilds = 0;
+    for (int step = 0; step < 600; ++step) {
+      for (std::size_t i = 0; i < d.x.size(); ++i) {
+        const double s = i < 4 ? 0.2e-6 : 0.01e-6;
+        d.x[i] += rng.uniform(-s, s);
+        d.y[i] += rng.uniform(-s, s);
+      }
+      double d1 = 0, d2 = 0;
+      for (std::size_t i = 0; i < d.x.size(); ++i) nl.track(i, d.x[i], d.y[i], d1, d2);
+      EXPECT_EQ(nl.exceeds(d1, d2), nl.needs_rebuild(d.x, d.y));
+      if (nl.exceeds(d1, d2)) { nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h); ++rebuilds; }
+      EXPECT_EQ(nl.per_disc(), per_disc);
+      const auto have = listed(nl);
+      for (std::size_t i = 0; i < d.x.size(); ++i)
+        for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+          if (d.body[i] == d.body[j]) continue;
+          const double rc = d.r[i] + d.r[j] + p.extra_range;
+          const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
+          if (dx * dx + dy * dy < rc * rc)
+            EXPECT_TRUE(have.count({static_cast<int>(i), static_cast<int>(j)})) << "pair " << i << "," << j << " step " << step;
+        }
+    }
+    return rebuilds;
+  };
+  const int one = walk(false), own = walk(true);
+  EXPECT_GT(own, 3);        // the walk does trigger rebuilds...
+  EXPECT_LT(2 * own, one);  // ...less than half as many as with one skin
+}
+
+// A skin per disc that is negative, not finite or missing is a caller's error, refused before
+// anything changes.
+TEST(NeighborList, BadSkinsPerDiscAreRefused) {
+  const test::DiscCloud d = test::random_discs(50, 100e-6, 2);
+  geometry::NeighborListParams p;
+  geometry::NeighborList nl;
+  std::vector<double> h(d.x.size(), 0.5e-6);
+  nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h);
+  const auto before = nl.nbr_;
+  for (double bad : {-1e-9, std::nan(""), 1.0 / 0.0}) {
+    h[7] = bad;
+    EXPECT_THROW(nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h), std::invalid_argument);
+  }
+  h.pop_back();
+  EXPECT_THROW(nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h), std::invalid_argument);
+  EXPECT_EQ(nl.nbr_, before);
+  EXPECT_EQ(nl.builds(), 1);
+}
+
 // Walls each disc may touch are listed at each neighbour-list build. A wall that changes shape
 // between builds (an experiment moving a plane) must still be felt at once: the lists are
 // rebuilt when any wall's shape differs from the one they were made for.
@@ -446,6 +557,55 @@ TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
   EXPECT_TRUE(every == run(0.1, 2, &t2));
   EXPECT_GT(t1, 10);
   EXPECT_LT(t1, 3000);
+}
+
+// Skins per disc (EngineParams::skin_speed_quantile) change when the list is rebuilt, never a
+// result. Tri-disc clusters with adhesion rain at up to 6 m/s onto a turning rough roller and
+// a floor (the roller test above): after 6,000 steps the state is bitwise that of one skin for
+// all, at 1 and 2 threads and for two quantiles, and the list was rebuilt less often.
+TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
+  auto run = [](double quantile, int threads, int* builds) {
+    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);
+    p.gravity = {0, -2e4};
+    p.threads = threads;
+    p.run_threads = threads;
+    p.skin_speed_quantile = quantile;
+    geometry::Wall roller;
+    roller.kind = geometry::Wall::Kind::cylinder;
+    roller.name = "roller";
+    roller.radius = 0.5e-3;
+    roller.centre = {0, -0.5e-3};
+    roller.omega = 600.0;
+    roller.interaction = 1;
+    geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
+    Simulation sim(p, {roller, test::plane_wall({0, -60e-6}, {0, 1}, 1, "floor")});
+    Rng rng(9);
+    for (int row = 0; row < 6; ++row)
+      for (int col = 0; col < 10; ++col) {
+        BodySpec s;
+        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+        s.radii = {3e-6, 3e-6, 2.5e-6};
+        s.density = 1700;
+        s.position = {14e-6 * col - 70e-6, 6e-6 + 14e-6 * row};
+        s.angle = rng.uniform(0, 6.28);
+        s.velocity = {rng.uniform(-0.5, 0.5), row % 3 == 0 ? -6.0 : rng.uniform(-1, -0.5)};
+        s.omega = rng.uniform(-1e5, 1e5);
+        sim.add_body(s);
+      }
+    for (int k = 0; k < 6000; ++k) sim.step();
+    EXPECT_GT(sim.contacts(), 10);
+    *builds = sim.neighbor_list().builds();
+    const auto& b = sim.bodies();
+    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
+  };
+  int one = 0, own1 = 0, own2 = 0, own_half = 0;
+  const auto same = run(0.0, 1, &one);
+  EXPECT_TRUE(same == run(0.9, 1, &own1));
+  EXPECT_TRUE(same == run(0.9, 2, &own2));
+  EXPECT_TRUE(same == run(0.5, 2, &own_half));
+  EXPECT_LT(own1, one);
+  EXPECT_EQ(own1, own2);
+  EXPECT_THROW(run(1.0, 1, &one), InputError);  // the quantile is checked
 }
 
 // The same where only the roller moves: discs at rest hover 30 nm above the roller's lands

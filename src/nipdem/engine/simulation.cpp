@@ -33,6 +33,8 @@ Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
   require_positive("engine", "dt_s", params_.dt);
   require_positive("engine", "skin_m", params_.skin);
   if (params_.threads < 1) throw_input("engine", "threads", std::to_string(params_.threads), "must be >= 1");
+  if (!(params_.skin_speed_quantile >= 0.0 && params_.skin_speed_quantile < 1.0))
+    throw_input("engine", "skin_speed_quantile", std::to_string(params_.skin_speed_quantile), "must be in [0, 1)");
   if (!(params_.inner_skin_fraction >= 0.0 && params_.inner_skin_fraction < 1.0))
     throw_input("engine", "inner_skin_fraction", std::to_string(params_.inner_skin_fraction), "must be in [0, 1)");
   if (params_.run_threads < 0 || params_.run_threads > params_.threads)
@@ -265,9 +267,11 @@ void Simulation::ensure_neighbor_list(int moved) {
   nl_params_.threads = team();
   try {
     if (structure_changed_) {
-      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_);
+      choose_skins();
+      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, old_of_new_, nl_params_, half_skin_);
     } else if (moved > 0 || (moved < 0 && nlist_.needs_rebuild(d_.x, d_.y))) {
-      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_);
+      choose_skins();
+      nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_, half_skin_);
     } else {
       return;
     }
@@ -285,9 +289,42 @@ void Simulation::ensure_neighbor_list(int moved) {
   build_wall_candidates();
 }
 
+// Each disc's skin for the next list build: skin/2, or for a disc faster than the quantile q of
+// the disc speeds u, u tau with tau = (skin/2) / u_q, the time skin/2 lasts a disc at the
+// quantile; at most kMaxSkinFactor skin/2, so the fast discs' searches stay a few cells wide.
+// The speed of a disc is that of its centre now. Empty (one skin for all) if q = 0, or if no
+// disc would get more than skin/2.
+void Simulation::choose_skins() {
+  const double q = params_.skin_speed_quantile, h0 = 0.5 * params_.skin;
+  const std::size_t n = d_.x.size();
+  half_skin_.clear();
+  if (q <= 0.0 || n < 2) return;
+  speed_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int b = d_.body[i];
+    const double w = b_.omega[b];
+    const double ux = b_.vx[b] - w * d_.wy[i], uy = b_.vy[b] + w * d_.wx[i];
+    const double u = std::sqrt(ux * ux + uy * uy);
+    speed_[i] = u == u ? u : 0.0;  // (a NaN velocity: the list build refuses its position anyway)
+  }
+  half_skin_.assign(speed_.begin(), speed_.end());
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(n - 1));
+  std::nth_element(half_skin_.begin(), half_skin_.begin() + k, half_skin_.end());
+  const double uq = half_skin_[static_cast<std::size_t>(k)];
+  const double cap = EngineParams::kMaxSkinFactor * h0;
+  bool wider = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    // u_i tau = h0 u_i / u_q, compared as u_i > u_q first (uq may be 0: a settled state)
+    const double h = speed_[i] > uq ? std::min(cap, h0 * (speed_[i] / uq)) : h0;
+    half_skin_[i] = h;
+    wider = wider || h > h0;
+  }
+  if (!wider) half_skin_.clear();
+}
+
 // Which walls each disc may touch until the next list build: may_touch() with the reach
-// widened by the skin, the most any disc moves between builds (the rebuild criterion keeps
-// the sum of the two largest displacements below it). A wall's may_touch() depends only on
+// widened by the farthest the disc can move before it (NeighborList::max_move), plus what it
+// has moved since the build when the masks are rebuilt in between. A wall's may_touch() depends only on
 // its fixed shape (plane position, cylinder axis and radius; not on its rotation), so the
 // masks stay valid while the shapes do; a changed shape rebuilds them (wall_shapes_changed).
 void Simulation::build_wall_candidates() {
@@ -302,12 +339,13 @@ void Simulation::build_wall_candidates() {
     return;
   }
   prepare_walls();
-  const double skin = params_.skin;
+  const bool listed = nlist_.size() == n;
 #pragma omp parallel for schedule(static) num_threads(team())
   for (std::size_t i = 0; i < n; ++i) {
+    const double move = listed ? nlist_.max_move(i) + std::sqrt(nlist_.displacement2(i, d_.x[i], d_.y[i])) : kInf;
     std::uint32_t m = 0;
     for (std::size_t w = 0; w < nw; ++w)
-      if (walls_[w].may_touch({d_.x[i], d_.y[i]}, d_.r[i], wall_reach_[w] + skin)) m |= std::uint32_t{1} << w;
+      if (walls_[w].may_touch({d_.x[i], d_.y[i]}, d_.r[i], wall_reach_[w] + move)) m |= std::uint32_t{1} << w;
     wall_mask_[i] = m;
     // A disc that can touch no wall until the next build has no wall contact to remember: its
     // history is cleared here (wall_disc() would clear it at this step's evaluation, which
@@ -833,7 +871,7 @@ void Simulation::step() {
       place_body(b);
       if (check_moves) {
         const int first = b_.first_disc[b], nd = b_.n_discs[b];
-        for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
+        for (int k = first; k < first + nd; ++k) nlist_.track(static_cast<std::size_t>(k), d_.x[k], d_.y[k], d1, d2);
       }
     }
     // The block's discs (contiguous: bodies own consecutive discs): the sublist's largest

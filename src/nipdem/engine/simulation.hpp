@@ -81,6 +81,13 @@ struct EngineParams {
   // displacements since it was taken add up to that margin (docs/performance.md, sixth pass).
   // Outputs do not depend on it (the same pairs interact, summed in the same order); 0 = off.
   double inner_skin_fraction = 0.25;
+  // Skins per disc (geometry::NeighborList): at each list build, a disc faster than this
+  // quantile of the disc speeds gets a skin in proportion to its speed (at most kMaxSkinFactor
+  // times its share skin/2), so that the list lasts about as long as skin/2 lasts a disc at the
+  // quantile, not as long as the skin lasts the two fastest (docs/performance.md, twelfth
+  // pass). Outputs do not depend on it (the same pairs interact); 0 = one skin for all.
+  double skin_speed_quantile = 0.9;
+  static constexpr double kMaxSkinFactor = 4.0;
   bool periodic_x = false;                  // periodic box along x
   double x_lo = 0.0, x_hi = 0.0;            // its extent [m]
   int threads = 1;                          // OpenMP threads for the force loops
@@ -180,6 +187,7 @@ class Simulation {
   void pack_disc(int i);
   void update_disc_positions(std::size_t b0, std::size_t b1);
   void ensure_neighbor_list(int moved);
+  void choose_skins();  // half_skin_ for the next list build (EngineParams::skin_speed_quantile)
   // kick_h > 0: also the closing half kick of velocity Verlet, body by body as its force is summed
   // (step() without force providers: one parallel region fewer per step); packed: step() has
   // already made the pair kernel's copy of the discs (pdisc_, pvel_) from the present state
@@ -220,6 +228,7 @@ class Simulation {
   geometry::NeighborList nlist_;
   geometry::NeighborListParams nl_params_;
   std::vector<int> old_of_new_;  // disc renumbering since the last list build
+  std::vector<double> half_skin_, speed_;  // per disc: skin of its own [m], speed (scratch) [m/s]
   bool structure_changed_ = true;
   bool forces_valid_ = false;
   std::vector<std::shared_ptr<BodyForce>> forces_;

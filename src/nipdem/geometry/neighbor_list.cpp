@@ -13,14 +13,27 @@ namespace nipdem::geometry {
 bool NeighborList::needs_rebuild(std::span<const double> x, std::span<const double> y) const {
   if (x.size() != x0_.size()) return true;
   double d1 = 0.0, d2 = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) top2(displacement2(i, x[i], y[i]), d1, d2);
+  for (std::size_t i = 0; i < x.size(); ++i) track(i, x[i], y[i], d1, d2);
   return exceeds(d1, d2);
 }
 
 void NeighborList::rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,
                            std::span<const int> body, std::span<const int> old_of_new,
-                           const NeighborListParams& p) {
+                           const NeighborListParams& p, std::span<const double> half_skin) {
   const std::size_t n = x.size();
+  const bool per_disc = !half_skin.empty();
+  double h_lo = 0.5 * p.skin, h_hi = h_lo;
+  if (per_disc) {
+    if (half_skin.size() != n) throw std::invalid_argument(fmt::format("neighbour list: {} skins for {} discs", half_skin.size(), n));
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(half_skin[i] >= 0.0 && std::isfinite(half_skin[i])))
+        throw std::invalid_argument(fmt::format("neighbour list: skin {} of disc {} is not finite and >= 0", half_skin[i], i));
+    if (n > 0) {
+      const auto [lo, hi] = std::minmax_element(half_skin.begin(), half_skin.end());
+      h_lo = *lo;
+      h_hi = *hi;
+    }
+  }
   params_ = p;
   skin_ = p.skin;
   new_start_.assign(n + 1, 0);
@@ -31,7 +44,8 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     ++builds_;
     row_start_ = new_start_;
     nbr_.clear(); eta_.clear(); slide_.clear();
-    x0_.clear(); y0_.clear();
+    x0_.clear(); y0_.clear(); h2_.clear();
+    wide_ = 0;
     return;
   }
   double rmax = 0.0, xmin = x[0], xmax = x[0], ymin = y[0], ymax = y[0];
@@ -42,8 +56,11 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     ymin = std::min(ymin, y[i]); ymax = std::max(ymax, y[i]);
     finite = finite & std::isfinite(x[i]) & std::isfinite(y[i]);
   }
-  const double reach = p.skin + p.extra_range;
-  double cell = 2.0 * rmax + reach;
+  // Within reach of each other: r_i + r_j + reach (+ h_i + h_j with skins per disc). The cells
+  // are as wide as the farthest pair of discs with the smallest skins can reach; a disc whose
+  // skin reaches farther is searched beyond its 3 x 3 cells (the wide search below).
+  const double reach = per_disc ? p.extra_range : p.skin + p.extra_range;
+  double cell = 2.0 * rmax + (per_disc ? p.extra_range + 2.0 * h_lo : reach);
   const double L = p.x_hi - p.x_lo;
   // Refuse what cannot be binned before anything depends on it (nothing has changed yet except
   // the scratch start array and the parameters, which the next build sets again).
@@ -103,10 +120,57 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   for (std::size_t c = 0; c < ncell; ++c) cell_start_[c + 1] += cell_start_[c];
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
   binned_.resize(n);
+  if (per_disc) binned_h_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const int k = cell_fill_[static_cast<std::size_t>(cell_of_[i])]++;
     binned_[static_cast<std::size_t>(k)] = {x[i], y[i], r[i], static_cast<int>(i), body[i]};
+    if (per_disc) binned_h_[static_cast<std::size_t>(k)] = half_skin[i];
   }
+  // The wide search: a pair farther apart than a cell may be within r_i + r_j + extra + h_i + h_j
+  // only if one of its discs has a skin that reaches beyond the cells around it; that disc, f,
+  // with the larger skin of the two (h_j <= h_f), finds it: each disc whose reach
+  // r_f + r_max + extra + 2 h_f exceeds a cell searches the cells that far around it for
+  // partners with h_j <= h_f farther than a cell (the nearer ones the row search finds). The
+  // pairs join their rows below. Serial: such discs are the few fast ones.
+  wide_ = 0;
+  wide_pairs_.clear();
+  if (per_disc && h_hi > h_lo) {
+    const double cell2 = cell * cell;
+    for (std::size_t f = 0; f < n; ++f) {
+      const double hf = half_skin[f];
+      const double reach_f = r[f] + rmax + p.extra_range + 2.0 * hf;
+      if (!(reach_f > cell)) continue;
+      ++wide_;
+      const int k = static_cast<int>(std::ceil(reach_f / cell));
+      const int cx = cell_of_[f] % nx, cy = cell_of_[f] / nx;
+      for (int yy = std::max(0, cy - k); yy <= std::min(ny - 1, cy + k); ++yy) {
+        const int xa = p.periodic_x ? cx - k : std::max(0, cx - k), xb = p.periodic_x ? cx + k : std::min(nx - 1, cx + k);
+        for (int xc = xa; xc <= xb; ++xc) {
+          const int xx = p.periodic_x ? ((xc % nx) + nx) % nx : xc;  // (a narrow box: repeats, removed below)
+          const std::size_t c = static_cast<std::size_t>(yy) * nx + static_cast<std::size_t>(xx);
+          for (int q = cell_start_[c]; q < cell_start_[c + 1]; ++q) {
+            const Binned& d = binned_[static_cast<std::size_t>(q)];
+            const double hj = binned_h_[static_cast<std::size_t>(q)];
+            if (d.index == static_cast<int>(f) || d.body == body[f] || hj > hf) continue;
+            double dx = d.x - x[f];
+            const double dy = d.y - y[f];
+            if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
+            const double rc = r[f] + d.r + p.extra_range + hf + hj;
+            const double d2 = dx * dx + dy * dy;
+            if (d2 < rc * rc && d2 > cell2)
+              wide_pairs_.emplace_back(std::min(static_cast<int>(f), d.index), std::max(static_cast<int>(f), d.index));
+          }
+        }
+      }
+    }
+    std::sort(wide_pairs_.begin(), wide_pairs_.end());
+    wide_pairs_.erase(std::unique(wide_pairs_.begin(), wide_pairs_.end()), wide_pairs_.end());
+  }
+  wide_start_.assign(n + 1, 0);
+  wide_nbr_.resize(wide_pairs_.size());
+  for (const auto& [a, b] : wide_pairs_) ++wide_start_[static_cast<std::size_t>(a) + 1];
+  for (std::size_t i = 0; i < n; ++i) wide_start_[i + 1] += wide_start_[i];
+  for (std::size_t q = 0; q < wide_pairs_.size(); ++q) wide_nbr_[q] = wide_pairs_[q].second;  // (sorted by row)
   // Rows are searched in parallel, each thread over one contiguous range of rows into its own
   // buffers, then concatenated in order: the list is the same for any thread count.
   const int nt = std::max(1, std::min(p.threads, static_cast<int>(n / 1024) + 1));
@@ -133,9 +197,22 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
       const double xi = x[i], yi = y[i], ri = r[i];
       const int bi = body[i], ii = static_cast<int>(i);
       m = 0;
+      const double hi = per_disc ? half_skin[i] : 0.0;
       auto scan = [&](int k, int k1) __attribute__((always_inline)) {
         if (static_cast<std::size_t>(m + (k1 - k)) > row.size()) row.resize(static_cast<std::size_t>(2 * (m + (k1 - k))));
         int* out = row.data();
+        if (per_disc) {
+          for (; k < k1; ++k) {
+            const Binned& d = binned_[static_cast<std::size_t>(k)];
+            double dx = d.x - xi;
+            const double dy = d.y - yi;
+            if (p.periodic_x) dx -= L * std::nearbyint(dx / L);
+            const double rc = ri + d.r + reach + hi + binned_h_[static_cast<std::size_t>(k)];
+            out[m] = d.index;
+            m += static_cast<int>((d.index > ii) & (d.body != bi) & (dx * dx + dy * dy < rc * rc));
+          }
+          return;
+        }
         for (; k < k1; ++k) {
           const Binned& d = binned_[static_cast<std::size_t>(k)];
           double dx = d.x - xi;
@@ -162,6 +239,10 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
             scan(cell_start_[c], cell_start_[c + 1]);
           }
         }
+      }
+      if (const int w0 = wide_start_[i], w1 = wide_start_[i + 1]; w1 > w0) {
+        if (static_cast<std::size_t>(m + (w1 - w0)) > row.size()) row.resize(static_cast<std::size_t>(2 * (m + (w1 - w0))));
+        for (int q = w0; q < w1; ++q) row[static_cast<std::size_t>(m++)] = wide_nbr_[static_cast<std::size_t>(q)];
       }
       std::sort(row.begin(), row.begin() + m);
       m = static_cast<int>(std::unique(row.begin(), row.begin() + m) - row.begin());
@@ -213,6 +294,8 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   slide_.swap(new_slide_);
   x0_.assign(x.begin(), x.end());
   y0_.assign(y.begin(), y.end());
+  h2_.resize(per_disc ? n : 0);
+  for (std::size_t i = 0; i < h2_.size(); ++i) h2_[i] = half_skin[i] * half_skin[i];
 }
 
 }  // namespace nipdem::geometry

@@ -10,6 +10,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace nipdem::geometry {
@@ -44,14 +45,20 @@ class NeighborList {
   // (discs of one rigid cluster never interact). old_of_new[i] is the index disc i had at the
   // previous build (-1 if new); history of pairs present in both lists is carried over.
   // Pass an empty span if no disc was renumbered since the last build.
+  // half_skin (optional, one per disc, each >= 0 and finite): skins of their own. Pair (i, j)
+  // is then listed within r_i + r_j + extra + h_i + h_j, and the list holds while no disc has
+  // moved farther than its own h_i (track(), needs_rebuild()): a fast disc can be given a wide
+  // skin without widening everyone's. Empty: the one skin p.skin, with the two-largest criterion.
   // Throws BadPositionError (list unchanged) for a position that cannot be binned (see there).
   // No exception leaves the parallel row search: one thrown there (bad_alloc) is rethrown after it.
   void rebuild(std::span<const double> x, std::span<const double> y, std::span<const double> r,
-               std::span<const int> body, std::span<const int> old_of_new, const NeighborListParams& p);
+               std::span<const int> body, std::span<const int> old_of_new, const NeighborListParams& p,
+               std::span<const double> half_skin = {});
 
   // True if the list may miss a pair: the two largest displacements since the last build
   // add up to more than the skin (no two discs can then have closed the skin between them;
-  // a plain max > skin/2 test rebuilds up to twice as often when a few discs move fast).
+  // a plain max > skin/2 test rebuilds up to twice as often when a few discs move fast); with
+  // skins per disc, some disc moved farther than its own.
   bool needs_rebuild(std::span<const double> x, std::span<const double> y) const;
 
   // Per-disc squared displacement since the last build, for fused loops that track the two
@@ -68,6 +75,19 @@ class NeighborList {
   }
   // True if the two largest squared displacements d1 >= d2 call for a rebuild.
   bool exceeds(double d1, double d2) const { return std::sqrt(d1) + std::sqrt(d2) > skin_; }
+  // Folds disc i at (x, y) into the running (d1, d2) that exceeds() then judges: its squared
+  // displacement into the top two, or with skins per disc, infinity if it moved beyond its own.
+  void track(std::size_t i, double x, double y, double& d1, double& d2) const {
+    const double d = displacement2(i, x, y);
+    if (h2_.empty()) top2(d, d1, d2);
+    else if (!(d <= h2_[i])) d1 = std::numeric_limits<double>::infinity();  // (NaN too)
+  }
+  bool per_disc() const { return !h2_.empty(); }
+  // The farthest disc i can move before the list must be rebuilt [m]: the skin (one disc may
+  // use all of it while the others stand still), or its own skin.
+  double max_move(std::size_t i) const { return h2_.empty() ? skin_ : std::sqrt(h2_[i]); }
+  // Discs searched beyond their 3 x 3 cells at the last build (their skins reach farther).
+  std::size_t wide_discs() const { return wide_; }
   // Folds squared displacement d into the running top two (d1 >= d2). A NaN (a disc whose
   // position became NaN) counts as infinitely far, so that it forces a rebuild and rebuild()
   // refuses it; compared as NaN it would be dropped by the next comparison.
@@ -93,6 +113,8 @@ class NeighborList {
 
  private:
   std::vector<double> x0_, y0_;  // positions at the last build
+  std::vector<double> h2_;       // squared skins per disc (empty: one skin for all)
+  std::size_t wide_ = 0;
   double skin_ = 0.0;
   NeighborListParams params_;
   int builds_ = 0;
@@ -100,6 +122,11 @@ class NeighborList {
   struct Binned { double x, y, r; int index, body; };  // a disc in cell order
   std::vector<int> cell_start_, cell_fill_, cell_of_;
   std::vector<Binned> binned_;
+  std::vector<double> binned_h_;  // skins per disc, in cell order
+  // pairs (i < j) found by the wide search of discs whose skins reach beyond their 3 x 3 cells,
+  // in CSR by row i (merged into the rows by the row search)
+  std::vector<std::pair<int, int>> wide_pairs_;
+  std::vector<int> wide_start_, wide_nbr_;
   std::vector<int> new_start_, new_nbr_;
   std::vector<double> new_eta_;
   std::vector<std::uint8_t> new_slide_;
