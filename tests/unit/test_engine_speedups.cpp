@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <array>
 #include <map>
 #include <set>
@@ -562,9 +563,11 @@ TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
 // Skins per disc (EngineParams::skin_speed_quantile) change when the list is rebuilt, never a
 // result. Tri-disc clusters with adhesion rain at up to 6 m/s onto a turning rough roller and
 // a floor (the roller test above): after 6,000 steps the state is bitwise that of one skin for
-// all, at 1 and 2 threads and for two quantiles, and the list was rebuilt less often.
+// all, at 1 and 2 threads and for two quantiles, and the list was rebuilt and the pair
+// kernel's sublist (its margins per disc follow the skins) taken again less often.
 TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
-  auto run = [](double quantile, int threads, int* builds) {
+  std::map<double, int> takes;
+  auto run = [&takes](double quantile, int threads, int* builds) {
     EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);
     p.gravity = {0, -2e4};
     p.threads = threads;
@@ -595,6 +598,7 @@ TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
     for (int k = 0; k < 6000; ++k) sim.step();
     EXPECT_GT(sim.contacts(), 10);
     *builds = sim.neighbor_list().builds();
+    takes[quantile] = sim.pair_sublist_builds();
     const auto& b = sim.bodies();
     return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega};
   };
@@ -605,6 +609,8 @@ TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
   EXPECT_TRUE(same == run(0.5, 2, &own_half));
   EXPECT_LT(own1, one);
   EXPECT_EQ(own1, own2);
+  EXPECT_LT(takes[0.9], takes[0.0]);
+  std::printf("list builds: one skin %d, own skins %d; sublist taken %d / %d times\n", one, own1, takes[0.0], takes[0.9]);
   EXPECT_THROW(run(1.0, 1, &one), InputError);  // the quantile is checked
 }
 

@@ -79,9 +79,9 @@ void rotate_by(double& c, double& s, double d) {
 }
 
 namespace {
-template <bool kPeriodic>
+template <bool kPeriodic, bool kWeighted>
 double max_disp2(const double* __restrict x, const double* __restrict y, const double* __restrict x0,
-                 const double* __restrict y0, std::size_t k0, std::size_t k1, double L) {
+                 const double* __restrict y0, const double* __restrict w, std::size_t k0, std::size_t k1, double L) {
   const double hL = 0.5 * L;
   std::int64_t m = 0;  // the bits of 0.0
   for (std::size_t k = k0; k < k1; ++k) {
@@ -95,7 +95,8 @@ double max_disp2(const double* __restrict x, const double* __restrict y, const d
     // max, which vectorises (a floating max does not without -ffinite-math-only). A NaN's bits
     // exceed every finite value's and infinity's, so it comes out as the max.
     std::int64_t b;
-    const double d2 = dx * dx + dy * dy;
+    double d2 = dx * dx + dy * dy;
+    if constexpr (kWeighted) d2 *= w[k];
     std::memcpy(&b, &d2, sizeof b);
     m = b > m ? b : m;
   }
@@ -108,7 +109,14 @@ double max_disp2(const double* __restrict x, const double* __restrict y, const d
 NIPDEM_TARGET_CLONES
 double max_displacement2(const double* x, const double* y, const double* x0, const double* y0, std::size_t k0,
                          std::size_t k1, bool periodic, double L) {
-  return periodic ? max_disp2<true>(x, y, x0, y0, k0, k1, L) : max_disp2<false>(x, y, x0, y0, k0, k1, L);
+  return periodic ? max_disp2<true, false>(x, y, x0, y0, nullptr, k0, k1, L)
+                  : max_disp2<false, false>(x, y, x0, y0, nullptr, k0, k1, L);
+}
+
+NIPDEM_TARGET_CLONES
+double max_weighted_displacement2(const double* x, const double* y, const double* x0, const double* y0,
+                                  const double* w, std::size_t k0, std::size_t k1, bool periodic, double L) {
+  return periodic ? max_disp2<true, true>(x, y, x0, y0, w, k0, k1, L) : max_disp2<false, true>(x, y, x0, y0, w, k0, k1, L);
 }
 
 NIPDEM_TARGET_CLONES

@@ -89,6 +89,11 @@ void drift_bodies(const DriftParams& p, std::size_t b0, std::size_t b1, const Bo
 double max_displacement2(const double* x, const double* y, const double* x0, const double* y0, std::size_t k0,
                          std::size_t k1, bool periodic, double L);
 
+// The same with each disc's squared displacement weighted by w[k] >= 0 (e.g. 1 / its allowed
+// displacement squared: the result exceeds 1 when some disc moved beyond what it may).
+double max_weighted_displacement2(const double* x, const double* y, const double* x0, const double* y0,
+                                  const double* w, std::size_t k0, std::size_t k1, bool periodic, double L);
+
 // Rotates the unit vector (c, s) by the angle d (any size); the scalar form of the rotation in
 // drift_bodies, bitwise the same for |d| <= 1e-2.
 void rotate_by(double& c, double& s, double d);

@@ -446,6 +446,7 @@ template <bool kAdhesion, bool kPeriodic, int kList>
     fxi = fyi = tqi = faxi = fayi = 0.0;
   };
   const double margin = sub_margin_;
+  const double* G = kList == 1 && sub_per_disc_ ? sub_g_.data() : nullptr;  // margins per disc
   int m = 0;
   auto test = [&](int e, int i, int j) __attribute__((always_inline)) {
     const PackedDisc& pi = P[i];
@@ -455,7 +456,7 @@ template <bool kAdhesion, bool kPeriodic, int kList>
     const double d2 = d.x * d.x + d.y * d.y;
     const bool interacts = d2 < rc * rc;
     if constexpr (kList == 1) {  // taken into the sublist within range + margin (branch-free)
-      const double rm = rc + margin;
+      const double rm = G ? rc + (G[i] + G[j]) : rc + margin;
       sub[m] = {e, i, j};
       m += d2 < rm * rm ? 1 : 0;
     }
@@ -541,6 +542,17 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     if (!ok) {
       sub_valid_ = false;
       sub_margin_ = margin;
+      // With skins per disc, margins per disc: the same fraction of each disc's own skin.
+      sub_per_disc_ = nlist_.per_disc() && nlist_.size() == static_cast<std::size_t>(n);
+      if (sub_per_disc_) {
+        sub_g_.resize(static_cast<std::size_t>(n));
+        sub_w_.resize(static_cast<std::size_t>(n));
+        for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
+          const double g = params_.inner_skin_fraction * nlist_.max_move(i);
+          sub_g_[i] = g;
+          sub_w_[i] = 1.0 / (0.99 * g * 0.99 * g);
+        }
+      }
       sub_.resize(nt);
       sub_n_.assign(nt, 0);
       for (int u = 0; u < nt; ++u)
@@ -626,7 +638,9 @@ void Simulation::contact_forces(double kick_h, bool packed) {
         if (wm != 0) {
           try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
             wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t], wall_nc);
-            if (take_near) wall_near_[i] = walls_near(static_cast<std::size_t>(i), margin, thread_hits_[t]);
+            if (take_near)
+              wall_near_[i] = walls_near(static_cast<std::size_t>(i), sub_per_disc_ ? sub_g_[i] + 0.5 * margin : margin,
+                                         thread_hits_[t]);
           } catch (...) {
             if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
           }
@@ -665,7 +679,8 @@ void Simulation::contact_forces(double kick_h, bool packed) {
 
 // A rough cylinder's surface moves with its rotation: no point of it has moved more than
 // |angle change| x radius since the sublist was taken. Together with the discs' half margin
-// (sub_exceeds) that keeps a disc left without a wall candidate out of its reach. Planes and
+// (sub_exceeds; with margins per disc, its own 0.99 g_i against candidates within g_i + half the
+// margin) that keeps a disc left without a wall candidate out of its reach. Planes and
 // smooth cylinders keep their shape as they move (a changed shape rebuilds the candidates).
 bool Simulation::walls_within_margin() const {
   if (sub_wall_angle_.size() != walls_.size()) return false;
@@ -697,7 +712,7 @@ std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<g
 bool Simulation::sublist_moved() const {
   double m = 0.0;
   for (std::size_t k = 0; k < d_.x.size(); ++k) {
-    const double d2 = sub_disp2(k);
+    const double d2 = sub_per_disc_ ? sub_disp2(k) * sub_w_[k] : sub_disp2(k);
     if (!(d2 <= m)) m = d2 == d2 ? d2 : kInf;  // (a NaN position: taken again, and refused by the list)
   }
   return sub_exceeds(m);
@@ -852,6 +867,7 @@ void Simulation::step() {
   thread_disp_.assign(4 * nt, 0.0);
   // the per-step sublist's displacements too, if it may still be used (contact_forces())
   const bool check_sub = check_moves && sub_valid_ && sub_x0_.size() == d_.x.size();
+  const bool list_per_disc = check_moves && nlist_.per_disc();
   pdisc_.resize(d_.x.size());
   pvel_.resize(d_.x.size());
 #pragma omp parallel num_threads(team())
@@ -869,9 +885,9 @@ void Simulation::step() {
     for (std::size_t b = c0; b < c1; ++b) {
       if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
       place_body(b);
-      if (check_moves) {
+      if (check_moves && !list_per_disc) {
         const int first = b_.first_disc[b], nd = b_.n_discs[b];
-        for (int k = first; k < first + nd; ++k) nlist_.track(static_cast<std::size_t>(k), d_.x[k], d_.y[k], d1, d2);
+        for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
       }
     }
     // The block's discs (contiguous: bodies own consecutive discs): the sublist's largest
@@ -879,9 +895,17 @@ void Simulation::step() {
     // contact_forces() then need not make in a pass (and a barrier) of its own.
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[c0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[c1 - 1] + b_.n_discs[c1 - 1]);
+    const double L = params_.x_hi - params_.x_lo;
+    if (list_per_disc) {  // a disc beyond its own skin (NeighborList::track, in a loop without branches)
+      const double m = detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), nlist_.x0(), nlist_.y0(),
+                                                          nlist_.inv_skin2(), k0, k1, periodic, L);
+      if (!(m <= 1.0)) d1 = kInf;
+    }
     if (check_sub) {
-      const double m = detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(), sub_y0_.data(), k0, k1,
-                                                 periodic, params_.x_hi - params_.x_lo);
+      const double m = sub_per_disc_ ? detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(),
+                                                                          sub_y0_.data(), sub_w_.data(), k0, k1, periodic, L)
+                                     : detail::max_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(),
+                                                                 sub_y0_.data(), k0, k1, periodic, L);
       s1 = m > s1 || m != m ? m : s1;  // (NaN wins)
     }
     for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));

@@ -284,7 +284,14 @@ class Simulation {
   // squared displacement m. Reached a little early (0.99), so that rounding in the displacements
   // never lets a pair left out of the sublist come into range unseen. (Twice the largest, not the
   // two largest as for the list: the sublist is cheap to take again, and a plain max vectorises.)
-  bool sub_exceeds(double m) const { return !(2.0 * std::sqrt(m) <= 0.99 * sub_margin_); }  // (NaN: true)
+  // With margins per disc (skins per disc: NeighborList::per_disc), m is the largest squared
+  // displacement weighted by sub_w_, 1 / (0.99 g_i)^2, each disc's margin g_i = inner_skin_fraction
+  // h_i (its share of a pair's margin g_i + g_j): true if some disc moved more than 0.99 g_i.
+  bool sub_exceeds(double m) const {
+    return sub_per_disc_ ? !(m <= 1.0) : !(2.0 * std::sqrt(m) <= 0.99 * sub_margin_);  // (NaN: true)
+  }
+  bool sub_per_disc_ = false;
+  std::vector<double> sub_g_, sub_w_;  // per disc: margin g_i [m], 1 / (0.99 g_i)^2 [1/m^2]
 };
 
 }  // namespace nipdem::engine

@@ -44,7 +44,7 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
     ++builds_;
     row_start_ = new_start_;
     nbr_.clear(); eta_.clear(); slide_.clear();
-    x0_.clear(); y0_.clear(); h2_.clear();
+    x0_.clear(); y0_.clear(); h_.clear(); inv_h2_.clear();
     wide_ = 0;
     return;
   }
@@ -294,8 +294,9 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   slide_.swap(new_slide_);
   x0_.assign(x.begin(), x.end());
   y0_.assign(y.begin(), y.end());
-  h2_.resize(per_disc ? n : 0);
-  for (std::size_t i = 0; i < h2_.size(); ++i) h2_[i] = half_skin[i] * half_skin[i];
+  h_.assign(half_skin.begin(), half_skin.end());
+  inv_h2_.resize(h_.size());
+  for (std::size_t i = 0; i < h_.size(); ++i) inv_h2_[i] = 1.0 / (h_[i] * h_[i]);  // (h = 0: inf, rebuilt at every check)
 }
 
 }  // namespace nipdem::geometry

@@ -79,13 +79,18 @@ class NeighborList {
   // displacement into the top two, or with skins per disc, infinity if it moved beyond its own.
   void track(std::size_t i, double x, double y, double& d1, double& d2) const {
     const double d = displacement2(i, x, y);
-    if (h2_.empty()) top2(d, d1, d2);
-    else if (!(d <= h2_[i])) d1 = std::numeric_limits<double>::infinity();  // (NaN too)
+    if (inv_h2_.empty()) top2(d, d1, d2);
+    else if (!(d * inv_h2_[i] <= 1.0)) d1 = std::numeric_limits<double>::infinity();  // (NaN too)
   }
-  bool per_disc() const { return !h2_.empty(); }
+  bool per_disc() const { return !inv_h2_.empty(); }
+  // With skins per disc: 1 / h_i^2 per disc, and the positions at the last build, for fused
+  // loops that judge the displacements themselves (a disc moved too far: d^2 / h_i^2 > 1).
+  const double* inv_skin2() const { return inv_h2_.data(); }
+  const double* x0() const { return x0_.data(); }
+  const double* y0() const { return y0_.data(); }
   // The farthest disc i can move before the list must be rebuilt [m]: the skin (one disc may
   // use all of it while the others stand still), or its own skin.
-  double max_move(std::size_t i) const { return h2_.empty() ? skin_ : std::sqrt(h2_[i]); }
+  double max_move(std::size_t i) const { return inv_h2_.empty() ? skin_ : h_[i]; }
   // Discs searched beyond their 3 x 3 cells at the last build (their skins reach farther).
   std::size_t wide_discs() const { return wide_; }
   // Folds squared displacement d into the running top two (d1 >= d2). A NaN (a disc whose
@@ -113,7 +118,7 @@ class NeighborList {
 
  private:
   std::vector<double> x0_, y0_;  // positions at the last build
-  std::vector<double> h2_;       // squared skins per disc (empty: one skin for all)
+  std::vector<double> h_, inv_h2_;  // skins per disc and 1 / their squares (empty: one skin for all)
   std::size_t wide_ = 0;
   double skin_ = 0.0;
   NeighborListParams params_;
