@@ -614,6 +614,54 @@ TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
   EXPECT_THROW(run(1.0, 1, &one), InputError);  // the quantile is checked
 }
 
+// What the skins per disc and the sublist's margins promise together: at every step the
+// contact list holds every pair of discs within interaction range (r_i + r_j + adhesion reach;
+// brute force over all pairs), though step() checks the list only when the sublist is taken
+// again (list_room_). Also the invariant behind it: no disc has moved farther than its own skin
+// since the list was built (one skin: no two discs farther than the skin together). Fast
+// tri-disc clusters (up to 4 m/s, 1.6 % of the skin per step) collide in a periodic box and
+// pile onto a floor for 3000 steps, with skins per disc and one for all.
+TEST(SkinsPerDisc, TheListAlwaysHoldsEveryPairInRange) {
+  for (double quantile : {0.9, 0.0}) {
+    EngineParams p = floor_box_params(200e-6, 1, 1);
+    p.skin_speed_quantile = quantile;
+    Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    add_cluster_grid(sim, 12, 5);
+    const double reach = p.interactions[0].adhesion.cutoff_m;
+    int missing = 0;
+    for (int k = 0; k < 3000 && missing == 0; ++k) {
+      sim.step();
+      const auto& d = sim.discs();
+      const auto& nl = sim.neighbor_list();
+      const auto have = listed(nl);
+      double d1 = 0, d2 = 0, worst = 0;
+      for (std::size_t i = 0; i < d.x.size(); ++i) {
+        const double m2 = nl.displacement2(i, d.x[i], d.y[i]);
+        geometry::NeighborList::top2(m2, d1, d2);
+        worst = std::max(worst, std::sqrt(m2) / nl.max_move(i));
+      }
+      EXPECT_EQ(nl.per_disc(), quantile > 0);
+      if (nl.per_disc()) {
+        EXPECT_LE(worst, 1.0) << "step " << k;
+      } else {
+        EXPECT_FALSE(nl.exceeds(d1, d2)) << "step " << k;
+      }
+      for (std::size_t i = 0; i < d.x.size(); ++i)
+        for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+          if (d.body[i] == d.body[j]) continue;
+          double dx = d.x[i] - d.x[j];
+          dx -= 200e-6 * std::nearbyint(dx / 200e-6);
+          const double dy = d.y[i] - d.y[j], rc = d.r[i] + d.r[j] + reach;
+          if (dx * dx + dy * dy < rc * rc && !have.count({static_cast<int>(i), static_cast<int>(j)})) {
+            ADD_FAILURE() << "quantile " << quantile << " step " << k << ": pair " << i << "," << j << " in range, not listed";
+            ++missing;
+          }
+        }
+    }
+    EXPECT_GT(sim.neighbor_list().builds(), 5) << quantile;  // the discs do move through the skins
+  }
+}
+
 // The same where only the roller moves: discs at rest hover 30 nm above the roller's lands
 // (inside the adhesion reach there, 15 um out of it above a pit) while it turns at 10 m/s, so
 // lands and pits pass under them and the adhesion pulls them only over a land. The discs

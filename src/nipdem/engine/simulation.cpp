@@ -263,7 +263,7 @@ int Simulation::team() {
 
 // moved: -1 = unknown (check every disc), 0/1 = the caller already checked (step() does it
 // in the drift loop).
-void Simulation::ensure_neighbor_list(int moved) {
+bool Simulation::ensure_neighbor_list(int moved) {
   nl_params_.threads = team();
   try {
     if (structure_changed_) {
@@ -273,7 +273,7 @@ void Simulation::ensure_neighbor_list(int moved) {
       choose_skins();
       nlist_.rebuild(d_.x, d_.y, d_.r, d_.body, {}, nl_params_, half_skin_);
     } else {
-      return;
+      return false;
     }
   } catch (const geometry::BadPositionError& e) {
     // A runtime failure (exit 1), not an input error: a checkpoint's positions are checked
@@ -287,6 +287,7 @@ void Simulation::ensure_neighbor_list(int moved) {
   structure_changed_ = false;
   for (std::size_t i = 0; i < old_of_new_.size(); ++i) old_of_new_[i] = static_cast<int>(i);
   build_wall_candidates();
+  return true;
 }
 
 // Each disc's skin for the next list build: skin/2, or for a disc faster than the quantile q of
@@ -560,6 +561,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     }
   }
   sub_moved_ = -1;
+  // Taken now with room in the list for the margins (list_room_): the list holds while this
+  // sublist does, and step() need not check it until the sublist is taken again.
+  if (list_mode != 2) list_check_ = !(list_mode == 1 && list_room_ == 1);
+  list_room_ = -1;
   // The wall candidates follow the sublist: taken with it, used with it (up to 32 walls, one
   // mask bit each). Each disc's bits start cleared, so a disc without candidates has none.
   const bool near_walls = has_walls && list_mode == 2 && walls_.size() <= 32;
@@ -709,6 +714,19 @@ std::uint32_t Simulation::walls_near(std::size_t i, double margin, std::vector<g
   return near;
 }
 
+// The list's displacement measures over every disc, as step()'s block loop takes them: the two
+// largest squared displacements (one skin), or the largest weighted by 1 / h_i^2 (skins per disc).
+void Simulation::list_displacements(double& d1, double& d2, double& l1) const {
+  d1 = d2 = l1 = 0.0;
+  const std::size_t n = d_.x.size();
+  if (nlist_.per_disc()) {
+    l1 = detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), nlist_.x0(), nlist_.y0(), nlist_.inv_skin2(), 0, n,
+                                            params_.periodic_x, params_.x_hi - params_.x_lo);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
+  }
+}
+
 bool Simulation::sublist_moved() const {
   double m = 0.0;
   for (std::size_t k = 0; k < d_.x.size(); ++k) {
@@ -832,7 +850,7 @@ void Simulation::provider_forces() {
 }
 
 void Simulation::compute_forces() {
-  ensure_neighbor_list(-1);
+  list_room_ = ensure_neighbor_list(-1) ? 1 : -1;
   contact_forces();
   provider_forces();
   forces_valid_ = true;
@@ -867,7 +885,10 @@ void Simulation::step() {
   thread_disp_.assign(4 * nt, 0.0);
   // the per-step sublist's displacements too, if it may still be used (contact_forces())
   const bool check_sub = check_moves && sub_valid_ && sub_x0_.size() == d_.x.size();
-  const bool list_per_disc = check_moves && nlist_.per_disc();
+  // The list's own check can wait while the sublist holds, if it was taken with room for its
+  // margins (list_check_, set by contact_forces()): see list_room_.
+  const bool check_list = check_moves && (list_check_ || !check_sub);
+  const bool list_per_disc = check_list && nlist_.per_disc();
   pdisc_.resize(d_.x.size());
   pvel_.resize(d_.x.size());
 #pragma omp parallel num_threads(team())
@@ -878,14 +899,14 @@ void Simulation::step() {
   // In blocks of bodies small enough that what the drift wrote is still in L1 when the discs
   // are placed, checked and packed (one pass over memory per step instead of three).
   constexpr std::size_t kBlock = 256;
-  double d1 = 0.0, d2 = 0.0, s1 = 0.0;
+  double d1 = 0.0, d2 = 0.0, s1 = 0.0, l1 = 0.0;
   for (std::size_t c0 = b0; c0 < b1; c0 += kBlock) {
     const std::size_t c1 = std::min(b1, c0 + kBlock);
     detail::drift_bodies(drift, c0, c1, arrays);
     for (std::size_t b = c0; b < c1; ++b) {
       if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
       place_body(b);
-      if (check_moves && !list_per_disc) {
+      if (check_list && !list_per_disc) {
         const int first = b_.first_disc[b], nd = b_.n_discs[b];
         for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
       }
@@ -896,10 +917,10 @@ void Simulation::step() {
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[c0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[c1 - 1] + b_.n_discs[c1 - 1]);
     const double L = params_.x_hi - params_.x_lo;
-    if (list_per_disc) {  // a disc beyond its own skin (NeighborList::track, in a loop without branches)
+    if (list_per_disc) {  // displacements relative to each disc's own skin (in a loop without branches)
       const double m = detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), nlist_.x0(), nlist_.y0(),
                                                           nlist_.inv_skin2(), k0, k1, periodic, L);
-      if (!(m <= 1.0)) d1 = kInf;
+      l1 = m > l1 || m != m ? m : l1;
     }
     if (check_sub) {
       const double m = sub_per_disc_ ? detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), sub_x0_.data(),
@@ -913,23 +934,45 @@ void Simulation::step() {
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;
   thread_disp_[4 * t + 2] = s1;
+  thread_disp_[4 * t + 3] = l1;
   }
   int moved = 0;
+  list_room_ = -1;
   if (check_moves) {
-    double d1 = 0.0, d2 = 0.0;
+    double d1 = 0.0, d2 = 0.0, l1 = 0.0;
     double s1 = 0.0;
+    auto fold = [](double v, double& m) { m = v > m || v != v ? v : m; };  // (NaN wins)
     for (int t = 0; t < nt; ++t) {
       geometry::NeighborList::top2(thread_disp_[4 * t], d1, d2);
       geometry::NeighborList::top2(thread_disp_[4 * t + 1], d1, d2);
-      s1 = thread_disp_[4 * t + 2] > s1 || thread_disp_[4 * t + 2] != thread_disp_[4 * t + 2] ? thread_disp_[4 * t + 2] : s1;
+      fold(thread_disp_[4 * t + 2], s1);
+      fold(thread_disp_[4 * t + 3], l1);
     }
-    moved = nlist_.exceeds(d1, d2) ? 1 : 0;
     if (check_sub) sub_moved_ = sub_exceeds(s1) ? 1 : 0;
+    for (auto& w : walls_) w.advance(dt);
+    // The sublist is to be taken again (discs moved, or a rough roller turned): the list is
+    // judged now if its check waited.
+    bool list_known = check_list;
+    if (!check_list && (sub_moved_ == 1 || (!walls_.empty() && !walls_within_margin()))) {
+      list_displacements(d1, d2, l1);
+      list_known = true;
+    }
+    if (list_known) {
+      const double room = 1.0 - params_.inner_skin_fraction;
+      if (nlist_.per_disc()) {
+        moved = !(l1 <= 1.0) ? 1 : 0;
+        list_room_ = l1 <= 0.99 * room * 0.99 * room ? 1 : 0;
+      } else {
+        moved = nlist_.exceeds(d1, d2) ? 1 : 0;
+        list_room_ = std::sqrt(d1) + std::sqrt(d2) + params_.inner_skin_fraction * params_.skin <= 0.99 * params_.skin ? 1 : 0;
+      }
+    }
+  } else {
+    for (auto& w : walls_) w.advance(dt);
   }
-  for (auto& w : walls_) w.advance(dt);
   time_ += dt;
   ++step_;
-  ensure_neighbor_list(check_moves ? moved : -1);
+  if (ensure_neighbor_list(check_moves ? moved : -1)) list_room_ = 1;  // (built now: nothing moved yet)
   // Without force providers nothing is added to the body forces after the contact sums, so the
   // closing half kick runs in contact_forces()'s region (bitwise the loop below).
   const bool kick_in_region = !newmark && forces_.empty();

@@ -186,7 +186,8 @@ class Simulation {
   void place_body(std::size_t b);
   void pack_disc(int i);
   void update_disc_positions(std::size_t b0, std::size_t b1);
-  void ensure_neighbor_list(int moved);
+  bool ensure_neighbor_list(int moved);  // true if it rebuilt the list
+  void list_displacements(double& d1, double& d2, double& l1) const;
   void choose_skins();  // half_skin_ for the next list build (EngineParams::skin_speed_quantile)
   // kick_h > 0: also the closing half kick of velocity Verlet, body by body as its force is summed
   // (step() without force providers: one parallel region fewer per step); packed: step() has
@@ -291,6 +292,13 @@ class Simulation {
     return sub_per_disc_ ? !(m <= 1.0) : !(2.0 * std::sqrt(m) <= 0.99 * sub_margin_);  // (NaN: true)
   }
   bool sub_per_disc_ = false;
+  // Whether the list has room for the sublist's margins at this step's evaluation: 1 if every
+  // disc may still move its margin g_i (or, one skin, two discs the whole margin) without
+  // leaving the list's skin, 0 if not, -1 unknown (set by step() and compute_forces()). A
+  // sublist taken with room holds only while every disc stays within its margin of where it
+  // was, so the list holds too and step() checks only the sublist (list_check_ = false).
+  int list_room_ = -1;
+  bool list_check_ = true;
   std::vector<double> sub_g_, sub_w_;  // per disc: margin g_i [m], 1 / (0.99 g_i)^2 [1/m^2]
 };
 
