@@ -210,6 +210,7 @@ void Simulation::load(std::istream& in) try {
   // the body arrays if they were valid when it was saved.
   old_of_new_ = std::move(old_of_new);
   structure_changed_ = true;
+  simple_valid_ = false;
   forces_valid_ = forces_valid != 0;
   for (auto& f : forces_) f->load(in);
 } catch (const InputError& e) {

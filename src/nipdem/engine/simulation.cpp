@@ -112,6 +112,7 @@ int Simulation::add_body(const BodySpec& s) {
   for (auto& v : prov_fy_) v.push_back(0.0);
   for (auto& v : prov_tq_) v.push_back(0.0);
   structure_changed_ = true;
+  simple_valid_ = false;
   forces_valid_ = false;
   return static_cast<int>(bi);
 }
@@ -154,6 +155,7 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   for (auto& v : prov_tq_) v.resize(bw);
   old_of_new_.swap(new_old_of_new);
   structure_changed_ = true;
+  simple_valid_ = false;
   forces_valid_ = false;
   return count;
 }
@@ -192,6 +194,7 @@ void Simulation::permute_bodies(std::span<const int> order) {
     for (int q = 0; q < b_.n_discs[b]; ++q) d_.body[k++] = static_cast<int>(b);
   }
   structure_changed_ = true;
+  simple_valid_ = false;
   ensure_neighbor_list(-1);  // now: energy() and the history mapping read the list
 }
 
@@ -246,6 +249,17 @@ inline void Simulation::place_body(std::size_t b) {
     d_.wx[k] = wx; d_.wy[k] = wy;
     d_.x[k] = X + wx; d_.y[k] = Y + wy;
   }
+}
+
+void Simulation::update_simple() {
+  const std::size_t nb = b_.x.size();
+  simple_prefix_.assign(nb + 1, 0);
+  for (std::size_t b = 0; b < nb; ++b) {
+    const int k = b_.first_disc[b];
+    const bool simple = b_.n_discs[b] == 1 && d_.ox[k] == 0.0 && d_.oy[k] == 0.0;
+    simple_prefix_[b + 1] = simple_prefix_[b] + (simple ? 1 : 0);
+  }
+  simple_valid_ = true;
 }
 
 void Simulation::update_disc_positions(std::size_t b0, std::size_t b1) {
@@ -578,6 +592,7 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     else pair_rows<A, Per, 0>(i0, i1, f, fa, nc, sub, sn);
   };
   const int run = team();  // threads that run the nt parts (results depend on nt only)
+  const bool simple_blocks = simple_valid_ && simple_prefix_.size() == static_cast<std::size_t>(nb) + 1;
 #pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();
@@ -651,7 +666,25 @@ void Simulation::contact_forces(double kick_h, bool packed) {
           }
         }
       }
-      if (kick_h > 0.0) {
+      if (simple_blocks && simple_prefix_[c1] - simple_prefix_[c0] == c1 - c0) {
+        // One disc per body at its centre (step()): reduce_body's sums with its offset (0, 0),
+        // in one loop without the disc ranges.
+        const Vec2 g = params_.gravity;
+        const double* m = b_.mass.data();
+        const double* dfx = d_.fx.data() + (k0 - c0); const double* dfy = d_.fy.data() + (k0 - c0);
+        const double* dtq = d_.tq.data() + (k0 - c0);
+        double* bfx = b_.fx.data(); double* bfy = b_.fy.data(); double* btq = b_.torque.data();
+        for (int bb = c0; bb < c1; ++bb) {
+          const double fx = 0.0 + dfx[bb], fy = 0.0 + dfy[bb];
+          bfx[bb] = fx + m[bb] * g.x;
+          bfy[bb] = fy + m[bb] * g.y;
+          btq[bb] = 0.0 + (dtq[bb] + 0.0 * dfy[bb] - 0.0 * dfx[bb]);
+        }
+        if (kick_h > 0.0)
+          for (int bb = c0; bb < c1; ++bb) {
+            vx[bb] += kick_h * bfx[bb] * im[bb]; vy[bb] += kick_h * bfy[bb] * im[bb]; om[bb] += kick_h * btq[bb] * iI[bb];
+          }
+      } else if (kick_h > 0.0) {
         // The same operations as step()'s own kick loop, so the same bits.
         for (int bb = c0; bb < c1; ++bb) {
           reduce_body(static_cast<std::size_t>(bb));
@@ -891,6 +924,7 @@ void Simulation::step() {
   const bool list_per_disc = check_list && nlist_.per_disc();
   pdisc_.resize(d_.x.size());
   pvel_.resize(d_.x.size());
+  if (!simple_valid_ || simple_prefix_.size() != nb + 1) update_simple();
 #pragma omp parallel num_threads(team())
   {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
@@ -903,19 +937,33 @@ void Simulation::step() {
   for (std::size_t c0 = b0; c0 < b1; c0 += kBlock) {
     const std::size_t c1 = std::min(b1, c0 + kBlock);
     detail::drift_bodies(drift, c0, c1, arrays);
-    for (std::size_t b = c0; b < c1; ++b) {
-      if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
-      place_body(b);
-      if (check_list && !list_per_disc) {
-        const int first = b_.first_disc[b], nd = b_.n_discs[b];
-        for (int k = first; k < first + nd; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
-      }
-    }
-    // The block's discs (contiguous: bodies own consecutive discs): the sublist's largest
-    // displacement, in a loop without branches, and the pair kernel's copy of them, which
-    // contact_forces() then need not make in a pass (and a barrier) of its own.
+    // The block's discs (contiguous: bodies own consecutive discs).
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[c0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[c1 - 1] + b_.n_discs[c1 - 1]);
+    const bool simple = simple_prefix_[c1] - simple_prefix_[c0] == static_cast<int>(c1 - c0);
+    for (std::size_t b = c0; b < c1; ++b)
+      if (std::fabs(dtheta_[b]) > 1e-2) detail::rotate_by(b_.cth[b], b_.sth[b], dtheta_[b]);
+    if (simple) {
+      // One disc per body at its centre: disc k = k0 + (b - c0) sits at the body's position, its
+      // offset (wx, wy) stays (0, 0); placed and packed in one loop (the same values as
+      // place_body and pack_disc, whose w * wy and w * wx are w * 0.0 here).
+      const double* r = d_.r.data(); const double* mass = b_.mass.data();
+      double* dx = d_.x.data(); double* dy = d_.y.data();
+      PackedDisc* pd = pdisc_.data(); PackedVel* pv = pvel_.data();
+      for (std::size_t b = c0, k = k0; b < c1; ++b, ++k) {
+        const double X = x[b], Y = y[b], w = om[b];
+        dx[k] = X; dy[k] = Y;
+        pd[k] = {X, Y, r[k], mass[b]};
+        pv[k] = {vx[b] - w * 0.0, vy[b] + w * 0.0, w, 0.0};
+      }
+    } else {
+      for (std::size_t b = c0; b < c1; ++b) place_body(b);
+    }
+    if (check_list && !list_per_disc)
+      for (std::size_t k = k0; k < k1; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
+    // The sublist's largest displacement, in a loop without branches, and the pair kernel's
+    // copy of the discs, which contact_forces() then need not make in a pass (and a barrier)
+    // of its own.
     const double L = params_.x_hi - params_.x_lo;
     if (list_per_disc) {  // displacements relative to each disc's own skin (in a loop without branches)
       const double m = detail::max_weighted_displacement2(d_.x.data(), d_.y.data(), nlist_.x0(), nlist_.y0(),
@@ -929,7 +977,8 @@ void Simulation::step() {
                                                                  sub_y0_.data(), k0, k1, periodic, L);
       s1 = m > s1 || m != m ? m : s1;  // (NaN wins)
     }
-    for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
+    if (!simple)
+      for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
   }
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;

@@ -291,6 +291,13 @@ class Simulation {
   bool sub_exceeds(double m) const {
     return sub_per_disc_ ? !(m <= 1.0) : !(2.0 * std::sqrt(m) <= 0.99 * sub_margin_);  // (NaN: true)
   }
+  // Bodies that are one disc at their centre of mass ("simple": a packing's grains) need no
+  // placement by rotation: step() copies a block of them at once. simple_prefix_[b]: how many
+  // of bodies [0, b) are simple (a block is simple if all its bodies are); rebuilt when the
+  // body set changes.
+  std::vector<int> simple_prefix_;
+  bool simple_valid_ = false;
+  void update_simple();
   bool sub_per_disc_ = false;
   // Whether the list has room for the sublist's margins at this step's evaluation: 1 if every
   // disc may still move its margin g_i (or, one skin, two discs the whole margin) without
