@@ -10,7 +10,8 @@
 //  - A pair contributes nothing unless it interacts, and history is reset the moment a
 //    contact opens, so results do not depend on when the neighbour list was rebuilt: this
 //    is what makes checkpoint/resume bitwise exact. The same holds for the pair kernel's
-//    per-step sublist of the list (EngineParams::inner_skin_fraction).
+//    per-step sublist of the list (EngineParams::inner_skin_fraction) and for the skins per
+//    disc both are taken with (EngineParams::skin_speed_quantile).
 //  - Bodies are added/removed/reordered between steps; the neighbour list is rebuilt with the
 //    index mapping so tangential history survives renumbering. The engine never reorders on its
 //    own: a caller that changes the body set anyway (the nip's inflow/outflow pass) sorts then
