@@ -707,53 +707,6 @@ TEST(SimpleBodies, SameBitsAsTheGeneralPath) {
   for (int threads : {1, 2}) EXPECT_TRUE(run(true, threads) == run(false, threads)) << threads << " threads";
 }
 
-// Which bodies each thread takes in the per-body loops (engine/body_split.hpp) changes speed,
-// never a result: tri-disc clusters with adhesion collide in a periodic box and pile onto a
-// floor for 2000 steps at 2 threads, with the split measured and fixed at 20/80 and 75/25 %,
-// and end bitwise alike (the pair rows keep their split, which orders the sums).
-TEST(BodySplit, ResultsDoNotDependOnWhichThreadTakesABody) {
-  auto run = [](std::vector<double> shares) {
-    Simulation sim(floor_box_params(200e-6, 2, 2), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
-    sim.fix_body_split(shares);
-    add_cluster_grid(sim, 12, 7);
-    for (int k = 0; k < 2000; ++k) sim.step();
-    EXPECT_GT(sim.contacts(), 10);
-    if (shares.size() == 2) EXPECT_NEAR(sim.body_split().share(0), shares[0] / (shares[0] + shares[1]), 1e-12);
-    const auto& b = sim.bodies();
-    return std::vector<std::vector<double>>{b.x, b.y, b.vx, b.vy, b.omega, b.fx, b.torque};
-  };
-  const auto measured = run({});
-  EXPECT_TRUE(measured == run({0.2, 0.8}));
-  EXPECT_TRUE(measured == run({0.75, 0.25}));
-}
-
-// The measured split follows the threads' time per body: a thread that took twice as long per
-// body gets a smaller share, halfway at each update, within [1/2, 3/2] of an even share.
-TEST(BodySplit, SharesFollowTheMeasuredTimePerBody) {
-  BodySplit s;
-  s.prepare(2);
-  EXPECT_EQ(s.first(1000, 1, 2), 500u);
-  for (int k = 0; k < BodySplit::kUpdateSteps; ++k) {
-    s.add_busy(0, 1e-3);
-    s.add_busy(1, 2e-3);  // thread 1 twice as slow per body
-    s.step_done();
-  }
-  EXPECT_NEAR(s.share(0), 0.5 * 0.5 + 0.5 * (2.0 / 3.0), 1e-12);  // halfway to 2/3
-  EXPECT_EQ(s.first(1000, 0, 2), 0u);
-  EXPECT_EQ(s.first(1000, 2, 2), 1000u);
-  EXPECT_EQ(s.first(999, 1, 2), static_cast<std::size_t>(s.share(0) * 999));
-  EXPECT_EQ(s.first(1000, 1, 3), 333u);  // another team: an even split
-  for (int u = 0; u < 20; ++u)
-    for (int k = 0; k < BodySplit::kUpdateSteps; ++k) {
-      s.add_busy(0, 1e-3);
-      s.add_busy(1, 1e-1);
-      s.step_done();
-    }
-  EXPECT_NEAR(s.share(0), 0.75, 1e-12);  // capped at 3/2 of an even share
-  s.prepare(3);                          // a new team starts even
-  EXPECT_NEAR(s.share(1), 1.0 / 3.0, 1e-12);
-}
-
 // The same where only the roller moves: discs at rest hover 30 nm above the roller's lands
 // (inside the adhesion reach there, 15 um out of it above a pit) while it turns at 10 m/s, so
 // lands and pits pass under them and the adhesion pulls them only over a land. The discs

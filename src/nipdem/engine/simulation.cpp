@@ -592,7 +592,6 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     else pair_rows<A, Per, 0>(i0, i1, f, fa, nc, sub, sn);
   };
   const int run = team();  // threads that run the nt parts (results depend on nt only)
-  body_split_.prepare(run);
   const bool simple_blocks = simple_valid_ && simple_prefix_.size() == static_cast<std::size_t>(nb) + 1;
 #pragma omp parallel num_threads(run)
   {
@@ -630,10 +629,8 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     // each disc's thread buffers in fixed thread order (bitwise reproducible for a given thread
     // count), add its wall forces, then sum its bodies (and kick them). A body's discs are in the
     // same share as the body, so no barrier is needed between the discs and the bodies.
-    // (which bodies: engine/body_split.hpp; the results do not depend on it)
-    const double t_busy = omp_get_wtime();
-    const int bl = static_cast<int>(body_split_.first(static_cast<std::size_t>(nb), t, team_size));
-    const int bh = static_cast<int>(body_split_.first(static_cast<std::size_t>(nb), t + 1, team_size));
+    const int bl = static_cast<int>(static_cast<std::int64_t>(nb) * t / team_size);
+    const int bh = static_cast<int>(static_cast<std::int64_t>(nb) * (t + 1) / team_size);
     // In blocks of bodies, so that a block's disc sums are still in L1 when its bodies read them.
     constexpr int kBlock = 256;
     double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
@@ -698,7 +695,6 @@ void Simulation::contact_forces(double kick_h, bool packed) {
       }
     }
     thread_nc_[t] += wall_nc;
-    if (team_size == run) body_split_.add_busy(t, omp_get_wtime() - t_busy);
   }
   if (has_walls)
     for (const auto& e : thread_fail_)
@@ -929,15 +925,11 @@ void Simulation::step() {
   pdisc_.resize(d_.x.size());
   pvel_.resize(d_.x.size());
   if (!simple_valid_ || simple_prefix_.size() != nb + 1) update_simple();
-  const int team_n = team();
-  body_split_.prepare(team_n);
-#pragma omp parallel num_threads(team_n)
+#pragma omp parallel num_threads(team())
   {
-  const double t_busy = omp_get_wtime();
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
-  const int team_size = omp_get_num_threads();
-  const std::size_t b0 = body_split_.first(nb, static_cast<int>(t), team_size);
-  const std::size_t b1 = body_split_.first(nb, static_cast<int>(t) + 1, team_size);
+  const std::size_t team_size = static_cast<std::size_t>(omp_get_num_threads());
+  const std::size_t b0 = nb * t / team_size, b1 = nb * (t + 1) / team_size;
   // In blocks of bodies small enough that what the drift wrote is still in L1 when the discs
   // are placed, checked and packed (one pass over memory per step instead of three).
   constexpr std::size_t kBlock = 256;
@@ -992,7 +984,6 @@ void Simulation::step() {
   thread_disp_[4 * t + 1] = d2;
   thread_disp_[4 * t + 2] = s1;
   thread_disp_[4 * t + 3] = l1;
-  if (team_size == team_n) body_split_.add_busy(static_cast<int>(t), omp_get_wtime() - t_busy);
   }
   int moved = 0;
   list_room_ = -1;
@@ -1045,7 +1036,6 @@ void Simulation::step() {
     }
   }
   tuner_.step_done(omp_get_wtime() - t_start);
-  body_split_.step_done();
 }
 
 Energy Simulation::energy() const {

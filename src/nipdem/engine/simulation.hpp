@@ -28,7 +28,6 @@
 
 #include "nipdem/core/particles.hpp"
 #include "nipdem/core/vec2.hpp"
-#include "nipdem/engine/body_split.hpp"
 #include "nipdem/engine/team_tuner.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
 #include "nipdem/geometry/walls.hpp"
@@ -178,10 +177,6 @@ class Simulation {
   std::int64_t contacts() const { return n_contacts_; }
   // The thread-count choice (EngineParams::run_threads): threads in use, probes and switches so far.
   const TeamTuner& team_tuner() const { return tuner_; }
-  // Which bodies each running thread takes in the per-body loops (engine/body_split.hpp):
-  // measured unless fixed here (shares per thread of a team of that size; empty: measured).
-  const BodySplit& body_split() const { return body_split_; }
-  void fix_body_split(std::vector<double> shares) { body_split_.fix(std::move(shares)); }
 
   Energy energy() const;
   // Serialises the complete dynamic state (bodies, discs, histories, walls, time).
@@ -263,7 +258,6 @@ class Simulation {
   std::int64_t next_id_ = 0;
   std::int64_t n_contacts_ = 0;
   TeamTuner tuner_;
-  BodySplit body_split_;
   int tuner_threads_ = 0, tuner_fixed_ = -1;  // the params the tuner was set up for
   int team();                                 // threads to run the loops of this step with
   double pair_reach_ = 0.0;  // max adhesion cut-off of disc-disc interaction
