@@ -377,6 +377,37 @@ void add_cluster_grid(Simulation& sim, int n, std::uint64_t seed) {
       sim.add_body(s);
     }
 }
+// A rough roller (15 um pyramids, radius 0.5 mm) turning at 600 rad/s, and a plane floor at its side.
+std::vector<geometry::Wall> roller_and_floor() {
+  geometry::Wall roller;
+  roller.kind = geometry::Wall::Kind::cylinder;
+  roller.name = "roller";
+  roller.radius = 0.5e-3;
+  roller.centre = {0, -0.5e-3};
+  roller.omega = 600.0;
+  roller.interaction = 1;
+  geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
+  return {roller, test::plane_wall({0, -60e-6}, {0, 1}, 1, "floor")};
+}
+
+// 6 rows of 10 tri-disc clusters above the roller, random orientation and spin; vy(rng, row)
+// gives each its downward velocity (drawn after its vx, as the tests' streams expect).
+template <class Vy> void rain_clusters(Simulation& sim, Vy vy) {
+  Rng rng(9);
+  for (int row = 0; row < 6; ++row)
+    for (int col = 0; col < 10; ++col) {
+      BodySpec s;
+      s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
+      s.radii = {3e-6, 3e-6, 2.5e-6};
+      s.density = 1700;
+      s.position = {14e-6 * col - 70e-6, 6e-6 + 14e-6 * row};
+      s.angle = rng.uniform(0, 6.28);
+      const double vx = rng.uniform(-0.5, 0.5);
+      s.velocity = {vx, vy(rng, row)};
+      s.omega = rng.uniform(-1e5, 1e5);
+      sim.add_body(s);
+    }
+}
 }  // namespace
 
 // How many threads run the engine's loops (EngineParams::run_threads; engine/team_tuner.hpp)
@@ -524,28 +555,8 @@ TEST(PairSublist, SameResultsOnARotatingRoughRoller) {
     p.gravity = {0, -2e4};
     p.threads = threads;
     p.run_threads = threads;
-    geometry::Wall roller;
-    roller.kind = geometry::Wall::Kind::cylinder;
-    roller.name = "roller";
-    roller.radius = 0.5e-3;
-    roller.centre = {0, -0.5e-3};
-    roller.omega = 600.0;
-    roller.interaction = 1;
-    geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
-    Simulation sim(p, {roller, test::plane_wall({0, -60e-6}, {0, 1}, 1, "floor")});
-    Rng rng(9);
-    for (int row = 0; row < 6; ++row)
-      for (int col = 0; col < 10; ++col) {
-        BodySpec s;
-        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
-        s.radii = {3e-6, 3e-6, 2.5e-6};
-        s.density = 1700;
-        s.position = {14e-6 * col - 70e-6, 6e-6 + 14e-6 * row};
-        s.angle = rng.uniform(0, 6.28);
-        s.velocity = {rng.uniform(-0.5, 0.5), rng.uniform(-6, -3)};
-        s.omega = rng.uniform(-1e5, 1e5);
-        sim.add_body(s);
-      }
+    Simulation sim(p, roller_and_floor());
+    rain_clusters(sim, [](Rng& rng, int) { return rng.uniform(-6, -3); });
     for (int k = 0; k < 6000; ++k) sim.step();
     EXPECT_GT(sim.contacts(), 10);
     *takes = sim.pair_sublist_builds();
@@ -573,28 +584,8 @@ TEST(SkinsPerDisc, SameResultsAsOneSkinForAll) {
     p.threads = threads;
     p.run_threads = threads;
     p.skin_speed_quantile = quantile;
-    geometry::Wall roller;
-    roller.kind = geometry::Wall::Kind::cylinder;
-    roller.name = "roller";
-    roller.radius = 0.5e-3;
-    roller.centre = {0, -0.5e-3};
-    roller.omega = 600.0;
-    roller.interaction = 1;
-    geometry::set_pyramid_roughness(roller, 15e-6, 50e-6, 20e-6);
-    Simulation sim(p, {roller, test::plane_wall({0, -60e-6}, {0, 1}, 1, "floor")});
-    Rng rng(9);
-    for (int row = 0; row < 6; ++row)
-      for (int col = 0; col < 10; ++col) {
-        BodySpec s;
-        s.offsets = {{-3e-6, 0}, {3e-6, 0}, {0, 4e-6}};
-        s.radii = {3e-6, 3e-6, 2.5e-6};
-        s.density = 1700;
-        s.position = {14e-6 * col - 70e-6, 6e-6 + 14e-6 * row};
-        s.angle = rng.uniform(0, 6.28);
-        s.velocity = {rng.uniform(-0.5, 0.5), row % 3 == 0 ? -6.0 : rng.uniform(-1, -0.5)};
-        s.omega = rng.uniform(-1e5, 1e5);
-        sim.add_body(s);
-      }
+    Simulation sim(p, roller_and_floor());
+    rain_clusters(sim, [](Rng& rng, int row) { return row % 3 == 0 ? -6.0 : rng.uniform(-1, -0.5); });
     for (int k = 0; k < 6000; ++k) sim.step();
     EXPECT_GT(sim.contacts(), 10);
     *builds = sim.neighbor_list().builds();
