@@ -430,6 +430,51 @@ TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
   EXPECT_TRUE(one == measured);
 }
 
+// Each part of the pair rows writes its own discs and their listed partners, which across a
+// periodic seam lie at the far end of the disc order; only the blocks a part may write are
+// read and cleared in the reduction (part_touch_). Disc 0 (x = 2.8 um) and the last disc (x =
+// 197.1 um) touch across the seam of a 200 um box; 72 pairs of touching discs in between (rows
+// above) give the second part rows of its own, so the last disc lies in it, two blocks of 64
+// discs past the first part's own rows, while its only force comes from the first part's row
+// of disc 0. With one contact per disc every force is 0 + one value, so
+// 1 and 2 parts give the same bits; a part's write left out of the reduction would leave the
+// last disc at rest (or give it a stale force later).
+TEST(PartBuffers, APartnerAcrossThePeriodicSeamIsSummed) {
+  auto run = [](int threads) {
+    EngineParams p = sublist_params(EngineParams{}.inner_skin_fraction);
+    p.periodic_x = true;
+    p.x_lo = 0;
+    p.x_hi = 200e-6;
+    p.threads = threads;
+    p.run_threads = threads;
+    Simulation sim(p, {});
+    auto disc = [&](double x, double y) {
+      BodySpec s;
+      s.offsets = {{0, 0}};
+      s.radii = {3e-6};
+      s.density = 1700;
+      s.position = {x, y};
+      sim.add_body(s);
+    };
+    disc(2.8e-6, 50e-6);
+    for (int row = 0; row < 6; ++row)
+      for (int k = 0; k < 12; ++k) {
+        disc(15e-6 + 14e-6 * k, 70e-6 + 14e-6 * row);
+        disc(15e-6 + 14e-6 * k + 5.9e-6, 70e-6 + 14e-6 * row);
+      }
+    disc(200e-6 - 2.9e-6, 50e-6);
+    for (int k = 0; k < 10; ++k) sim.step();
+    return std::pair{sim.bodies().vx, sim.bodies().x};
+  };
+  const auto one = run(1), two = run(2);
+  ASSERT_EQ(one.first.size(), 146u);
+  const double va = one.first.front(), vb = one.first.back();
+  EXPECT_GT(va, 0.0);  // pushed apart across the seam: disc 0 to +x, the last disc to -x
+  EXPECT_LT(vb, 0.0);
+  EXPECT_NEAR(va, -vb, 1e-12 * va);  // equal masses: momentum is conserved pair by pair
+  EXPECT_TRUE(one == two);
+}
+
 // The choice itself, on step times made up: the team whose median probe block is faster is
 // kept, and the next probe can switch back when the load changes.
 TEST(TeamTuner, KeepsTheFasterTeamAndProbesAgain) {

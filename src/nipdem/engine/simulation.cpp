@@ -388,9 +388,9 @@ bool Simulation::wall_shapes_changed() const {
   return false;
 }
 
-// Row ranges per thread, balanced by list entries, and the highest disc index each range
-// writes to (rows hold j > i only, so a thread touches [split_[t], reach_hi_[t])). Recomputed
-// only when the list or the thread count changes.
+// Row ranges per thread, balanced by list entries, and the blocks of discs each range writes to
+// (its own rows and their listed partners). Recomputed only when the list or the thread count
+// changes.
 void Simulation::update_thread_split() {
   const int nt = params_.threads;
   const int n = static_cast<int>(d_.x.size());
@@ -401,7 +401,6 @@ void Simulation::update_thread_split() {
   for (int i = 0; i < n; ++i)
     std::fill(entry_row_.begin() + nlist_.row_start_[i], entry_row_.begin() + nlist_.row_start_[i + 1], i);
   split_.assign(nt + 1, 0);
-  reach_hi_.assign(nt, 0);
   const auto& rs = nlist_.row_start_;
   const double per = static_cast<double>(nlist_.pair_count()) / nt;
   for (int t = 1; t < nt; ++t) {
@@ -410,11 +409,14 @@ void Simulation::update_thread_split() {
     split_[t] = std::clamp(s, split_[t - 1], n);
   }
   split_[nt] = n;
+  touch_blocks_ = (n >> kTouchShift) + 1;
+  part_touch_.assign(static_cast<std::size_t>(nt) * touch_blocks_, 0);
   for (int t = 0; t < nt; ++t) {
-    int hi = split_[t + 1];
-    for (int i = split_[t]; i < split_[t + 1]; ++i)
-      if (rs[i + 1] > rs[i]) hi = std::max(hi, nlist_.nbr_[rs[i + 1] - 1] + 1);  // rows are sorted
-    reach_hi_[t] = hi;
+    std::uint8_t* m = part_touch_.data() + static_cast<std::size_t>(t) * touch_blocks_;
+    if (split_[t] < split_[t + 1])
+      std::fill(m + (split_[t] >> kTouchShift), m + ((split_[t + 1] - 1) >> kTouchShift) + 1, 1);
+    if (nt > 1)
+      for (int e = rs[split_[t]]; e < rs[split_[t + 1]]; ++e) m[nlist_.nbr_[e] >> kTouchShift] = 1;
   }
 }
 
@@ -638,20 +640,56 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     for (int c0 = bl; c0 < bh; c0 += kBlock) {
       const int c1 = std::min(bh, c0 + kBlock);
       const int k0 = b_.first_disc[c0], k1 = c1 < nb ? b_.first_disc[c1] : n;
-      for (int i = k0; i < k1; ++i) {
-        double a = 0, b = 0, c = 0, p = 0, q = 0;
-        for (int u = 0; u < nt; ++u) {
-          if (i < split_[u] || i >= reach_hi_[u]) continue;
-          PackedForce& g = tforce_[u][i];
-          a += g.fx; b += g.fy; c += g.tq;
-          g = PackedForce{0.0, 0.0, 0.0, 0.0};
-          if (adh) {
-            double* h = &tadh_[u][2 * i];
-            p += h[0]; q += h[1];
-            h[0] = 0.0; h[1] = 0.0;
+      // The parts whose rows may have written into this block's discs (part_touch_). Most blocks
+      // have one, and their sums are read from that one buffer in a loop without the part tests.
+      // A skipped part holds +0 for the disc, and a sum that starts at +0 is never -0, so adding
+      // it would change no bit: the sums are those of all parts in part order.
+      int parts = 0, only = 0;
+      for (int u = 0; u < nt; ++u) {
+        const std::uint8_t* m = part_touch_.data() + static_cast<std::size_t>(u) * touch_blocks_;
+        for (int q = k0 >> kTouchShift; q <= (k1 - 1) >> kTouchShift; ++q)
+          if (m[q]) { ++parts; only = u; break; }
+      }
+      double* dfx = d_.fx.data(); double* dfy = d_.fy.data(); double* dtq = d_.tq.data();
+      double* dfax = d_.fax.data(); double* dfay = d_.fay.data();
+      if (parts == 1) {  // (every disc is in its own part's range: that one)
+        PackedForce* g = tforce_[only].data();
+        if (adh) {
+          double* h = tadh_[only].data();
+          for (int i = k0; i < k1; ++i) {
+            double a = 0.0, b = 0.0, c = 0.0, p = 0.0, q = 0.0;
+            a += g[i].fx; b += g[i].fy; c += g[i].tq; p += h[2 * i]; q += h[2 * i + 1];
+            g[i] = PackedForce{0.0, 0.0, 0.0, 0.0};
+            h[2 * i] = 0.0; h[2 * i + 1] = 0.0;
+            dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = p; dfay[i] = q;
+          }
+        } else {
+          for (int i = k0; i < k1; ++i) {
+            double a = 0.0, b = 0.0, c = 0.0;
+            a += g[i].fx; b += g[i].fy; c += g[i].tq;
+            g[i] = PackedForce{0.0, 0.0, 0.0, 0.0};
+            dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = 0.0; dfay[i] = 0.0;
           }
         }
-        d_.fx[i] = a; d_.fy[i] = b; d_.tq[i] = c; d_.fax[i] = p; d_.fay[i] = q;
+      } else {
+        for (int i = k0; i < k1; ++i) {
+          double a = 0, b = 0, c = 0, p = 0, q = 0;
+          for (int u = 0; u < nt; ++u) {
+            if (!part_touch_[static_cast<std::size_t>(u) * touch_blocks_ + (i >> kTouchShift)]) continue;
+            PackedForce& g = tforce_[u][i];
+            a += g.fx; b += g.fy; c += g.tq;
+            g = PackedForce{0.0, 0.0, 0.0, 0.0};
+            if (adh) {
+              double* h = &tadh_[u][2 * i];
+              p += h[0]; q += h[1];
+              h[0] = 0.0; h[1] = 0.0;
+            }
+          }
+          dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = p; dfay[i] = q;
+        }
+      }
+      // then each disc's wall forces, added to its pair sums
+      for (int i = has_walls ? k0 : k1; i < k1; ++i) {
         // Walls: the candidates of the list build, or while the sublist is in use only those
         // within reach + margin when it was taken (most discs: none, no call).
         const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];

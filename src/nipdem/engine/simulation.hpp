@@ -239,9 +239,14 @@ class Simulation {
   std::vector<PackedVel> pvel_;
   std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers
   std::vector<std::vector<double>> tadh_;         // per-thread adhesive part (fax, fay interleaved)
-  // Thread t owns list rows [split_[t], split_[t+1]) and writes discs [split_[t], reach_hi_[t]):
-  // only that window of its buffer is zeroed and reduced.
-  std::vector<int> split_, reach_hi_;
+  // Thread t owns list rows [split_[t], split_[t+1]) and writes its own discs and their listed
+  // partners (j > i, which may lie anywhere after split_[t+1]: across a periodic seam, the far
+  // end of the order). part_touch_[t * touch_blocks_ + (i >> kTouchShift)] is 1 if it may write
+  // disc i: only those blocks of its buffer are read and zeroed.
+  static constexpr int kTouchShift = 6;
+  std::vector<int> split_;
+  std::vector<std::uint8_t> part_touch_;
+  int touch_blocks_ = 0;
   std::vector<int> entry_row_;  // the list row (disc i) of each list entry, for the flat pair loop
   std::vector<std::int64_t> thread_nc_;
   std::vector<double> inv_mass_, inv_inertia_, dtheta_;  // per body, 1/m, 1/I and the rotation of this step (scratch of step())
