@@ -640,6 +640,12 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     for (int c0 = bl; c0 < bh; c0 += kBlock) {
       const int c1 = std::min(bh, c0 + kBlock);
       const int k0 = b_.first_disc[c0], k1 = c1 < nb ? b_.first_disc[c1] : n;
+      // the force providers' arrays, cleared for provider_forces() (which follows every call)
+      for (std::size_t k = 0; k < forces_.size(); ++k) {
+        std::fill(prov_fx_[k].begin() + c0, prov_fx_[k].begin() + c1, 0.0);
+        std::fill(prov_fy_[k].begin() + c0, prov_fy_[k].begin() + c1, 0.0);
+        std::fill(prov_tq_[k].begin() + c0, prov_tq_[k].begin() + c1, 0.0);
+      }
       // The parts whose rows may have written into this block's discs (part_touch_). Most blocks
       // have one, and their sums are read from that one buffer in a loop without the part tests.
       // A skipped part holds +0 for the disc, and a sum that starts at +0 is never -0, so adding
@@ -906,24 +912,33 @@ inline void Simulation::reduce_body(std::size_t b) {
 }
 
 // The body forces of the external providers (serial: their code is not ours).
-void Simulation::provider_forces() {
+// Their arrays were cleared by contact_forces()' body loop; the sums into the bodies (in
+// provider order, as before) and the closing half kick (kick_h > 0) run in one parallel loop.
+void Simulation::provider_forces(double kick_h) {
   const std::size_t nb = b_.x.size();
-  for (std::size_t k = 0; k < forces_.size(); ++k) {
-    std::fill(prov_fx_[k].begin(), prov_fx_[k].end(), 0.0);
-    std::fill(prov_fy_[k].begin(), prov_fy_[k].end(), 0.0);
-    std::fill(prov_tq_[k].begin(), prov_tq_[k].end(), 0.0);
+  const std::size_t np = forces_.size();
+  if (np == 0) return;
+  for (std::size_t k = 0; k < np; ++k) {
     forces_[k]->set_running_threads(team());
     forces_[k]->add(b_, d_, time_, prov_fx_[k], prov_fy_[k], prov_tq_[k]);
-    for (std::size_t b = 0; b < nb; ++b) {
-      b_.fx[b] += prov_fx_[k][b]; b_.fy[b] += prov_fy_[k][b]; b_.torque[b] += prov_tq_[k][b];
+  }
+  double* fx = b_.fx.data(); double* fy = b_.fy.data(); double* tq = b_.torque.data();
+  double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
+  const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
+  const bool kick = kick_h > 0.0;
+#pragma omp parallel for schedule(static) num_threads(team())
+  for (std::size_t b = 0; b < nb; ++b) {
+    for (std::size_t k = 0; k < np; ++k) {
+      fx[b] += prov_fx_[k][b]; fy[b] += prov_fy_[k][b]; tq[b] += prov_tq_[k][b];
     }
+    if (kick) { vx[b] += kick_h * fx[b] * im[b]; vy[b] += kick_h * fy[b] * im[b]; om[b] += kick_h * tq[b] * iI[b]; }
   }
 }
 
 void Simulation::compute_forces() {
   list_room_ = ensure_neighbor_list(-1) ? 1 : -1;
   contact_forces();
-  provider_forces();
+  provider_forces(0.0);
   forces_valid_ = true;
 }
 
@@ -1064,15 +1079,9 @@ void Simulation::step() {
   // closing half kick runs in contact_forces()'s region (bitwise the loop below).
   const bool kick_in_region = !newmark && forces_.empty();
   contact_forces(kick_in_region ? 0.5 * dt : 0.0, true);
-  provider_forces();
+  // (with providers, the closing half kick runs in the loop that adds their forces)
+  provider_forces(!newmark && !kick_in_region ? 0.5 * dt : 0.0);
   forces_valid_ = true;
-  if (!newmark && !kick_in_region) {
-#pragma omp parallel for schedule(static) num_threads(team())
-    for (std::size_t b = 0; b < nb; ++b) {
-      const double h = 0.5 * dt;
-      vx[b] += h * fx[b] * inv_m[b]; vy[b] += h * fy[b] * inv_m[b]; om[b] += h * tq[b] * inv_I[b];
-    }
-  }
   tuner_.step_done(omp_get_wtime() - t_start);
 }
 

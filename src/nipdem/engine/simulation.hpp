@@ -49,7 +49,9 @@ struct Interaction {
 };
 
 // An external force on bodies (magnet, electric field, drag, ...). add() is called once per
-// force evaluation and adds to the per-body arrays; it must not resize them.
+// force evaluation and adds to the per-body arrays (cleared before each evaluation); it must
+// not resize them. The BodyStore's force sums are not complete during add(): the engine adds
+// all providers' arrays to them after the last add().
 class BodyForce {
  public:
   virtual ~BodyForce() = default;
@@ -199,7 +201,7 @@ class Simulation {
   std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits);  // (updates wall_hint_)
   bool walls_within_margin() const;
   void reduce_body(std::size_t b);
-  void provider_forces();
+  void provider_forces(double kick_h);  // (contact_forces() clears their arrays first)
   void update_thread_split();
   void build_wall_candidates();
   struct WallShape {
