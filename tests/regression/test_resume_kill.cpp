@@ -69,8 +69,11 @@ TEST(ResumeOnDisk, KilledAtManyMomentsThenResumedGivesTheUninterruptedFiles) {
     for (const auto& [f, _] : got) names_got += f + " ";
     ASSERT_EQ(names_got, names_want) << "the same files, no temp file left";
     for (const auto& [f, text] : want) {
-      if (f == "summary.json") EXPECT_EQ(stable_summary(got.at(f)), stable_summary(text));
-      else if (f != "checkpoint.bin") EXPECT_TRUE(got.at(f) == text) << f << " differs";
+      if (f == "summary.json") {
+        EXPECT_EQ(stable_summary(got.at(f)), stable_summary(text));
+      } else if (f != "checkpoint.bin") {
+        EXPECT_TRUE(got.at(f) == text) << f << " differs";
+      }
     }
     // the final checkpoints: the same physical state
     nipdem::nip::NipRun a(nipdem::nip::load_nip_config(cfg, overrides));

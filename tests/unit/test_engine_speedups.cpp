@@ -148,8 +148,9 @@ TEST(NeighborList, TwoLargestDisplacementCriterionNeverMissesAPair) {
         if (d.body[i] == d.body[j]) continue;
         const double rc = d.r[i] + d.r[j] + p.extra_range;
         const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
-        if (dx * dx + dy * dy < rc * rc)
+        if (dx * dx + dy * dy < rc * rc) {
           ASSERT_TRUE(have.count({static_cast<int>(i), static_cast<int>(j)})) << "pair " << i << "," << j << " step " << step;
+        }
       }
   }
   EXPECT_GT(rebuilds, 3);  // the walk does trigger rebuilds
@@ -236,8 +237,9 @@ TEST(NeighborList, SkinsPerDiscCriterionNeverMissesAPair) {
           if (d.body[i] == d.body[j]) continue;
           const double rc = d.r[i] + d.r[j] + p.extra_range;
           const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
-          if (dx * dx + dy * dy < rc * rc)
+          if (dx * dx + dy * dy < rc * rc) {
             EXPECT_TRUE(have.count({static_cast<int>(i), static_cast<int>(j)})) << "pair " << i << "," << j << " step " << step;
+          }
         }
     }
     return rebuilds;
