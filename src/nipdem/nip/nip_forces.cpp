@@ -101,15 +101,25 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
                       std::span<double>) {
   const std::size_t n = b.x.size();
   // Held forces belong to bodies by id; any change of the body set forces a fresh evaluation.
-  bool same = ids_.size() == n;
-  if (same) for (std::size_t i = 0; i < n && same; ++i) same = ids_[i] == b.id[i];
+  const bool same = ids_.size() == n && std::equal(ids_.begin(), ids_.end(), b.id.begin());
   if (!same || calls_ % cfg_.field_interval == 0) field_pass(b);
   if (cfg_.dipole_dipole && (!same || calls_ % cfg_.dipole_interval == 0)) dipole_pass(b, same);
   if (!same) ids_.assign(b.id.begin(), b.id.end());
   ++calls_;
-  for (std::size_t i = 0; i < n; ++i) { fx[i] += ffx_[i]; fy[i] += ffy_[i]; }
-  if (cfg_.dipole_dipole)
-    for (std::size_t i = 0; i < n; ++i) { fx[i] += dfx_[i]; fy[i] += dfy_[i]; }
+  // The held forces, added per body (the same sums for any thread count), on the engine's
+  // threads when there are enough bodies to pay for the region: a serial pass here is time
+  // the engine's other threads wait.
+  const bool dd = cfg_.dipole_dipole;
+  const int nt = std::max(1, cfg_.threads);
+  const int run = running_threads() > 0 ? std::min(running_threads(), nt) : nt;
+  const double* hx = ffx_.data(); const double* hy = ffy_.data();
+  const double* gx = dd ? dfx_.data() : nullptr; const double* gy = dd ? dfy_.data() : nullptr;
+  double* ox = fx.data(); double* oy = fy.data();
+#pragma omp parallel for schedule(static) num_threads(run) if (run > 1 && n >= 2048)
+  for (std::size_t i = 0; i < n; ++i) {
+    ox[i] += hx[i]; oy[i] += hy[i];
+    if (dd) { ox[i] += gx[i]; oy[i] += gy[i]; }
+  }
 }
 
 void MagnetForce::field_pass(const BodyStore& b) {
