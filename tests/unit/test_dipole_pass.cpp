@@ -199,3 +199,21 @@ TEST(DipolePass, FewerRunningThreadsGiveTheSameSums) {
     EXPECT_EQ(fy, fy3) << "running threads " << run;
   }
 }
+
+// The list itself is built on the running threads (rows in parts, joined in row order): three
+// PairSums of 3 parts whose first pass (the build) ran on 1, 2 and 3 threads hold the same list,
+// so their sums are bitwise alike.
+TEST(DipolePass, TheListIsTheSameBuiltOnAnyNumberOfThreads) {
+  const Cloud c = dense_cloud(330e-6, 3);
+  std::vector<double> fx1, fy1;
+  dipole::PairSum one({42e-6, 2e-6, 3});
+  one.compute(c.x, c.y, c.m, false, fx1, fy1, 1);
+  for (int run : {2, 3}) {
+    dipole::PairSum ps({42e-6, 2e-6, 3});
+    std::vector<double> fx, fy;
+    ps.compute(c.x, c.y, c.m, false, fx, fy, run);
+    EXPECT_EQ(ps.listed_pairs(), one.listed_pairs());
+    EXPECT_EQ(fx, fx1) << "built on " << run << " threads";
+    EXPECT_EQ(fy, fy1) << "built on " << run << " threads";
+  }
+}

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <fmt/format.h>
 #include <omp.h>
@@ -149,7 +150,7 @@ bool PairSum::moved(std::span<const double> x, std::span<const double> y) const 
   return std::sqrt(d1) + std::sqrt(d2) > 0.98 * p_.skin_m;
 }
 
-void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
+void PairSum::rebuild(std::span<const double> x, std::span<const double> y, int run) {
   const std::size_t n = x.size();
   const double reach = p_.cutoff_m + p_.skin_m, reach2 = reach * reach;
   double xmin = 0, xmax = 0, ymin = 0, ymax = 0;
@@ -184,41 +185,78 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y) {
   for (std::size_t i = 0; i < n; ++i)
     if (cell_of_[i] >= 0)
       binned_[static_cast<std::size_t>(cell_fill_[static_cast<std::size_t>(cell_of_[i])]++)] = {x[i], y[i], static_cast<int>(i)};
+  // Rows are searched in parts of consecutive rows, on up to `run` threads, each into its own
+  // buffer (row lengths into row_start_[i + 1]), then joined in row order: the list is the same
+  // for any number of parts. Nothing that can throw leaves the region (the buffers grow inside
+  // it: a bad_alloc is carried out and rethrown).
   row_start_.assign(n + 1, 0);
-  nbr_.clear();
-  max_row_ = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    row_start_[i] = static_cast<int>(nbr_.size());
-    if (cell_of_[i] < 0) continue;
-    const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
-    const int ii = static_cast<int>(i);
-    const double xi = x[i], yi = y[i];
-    // Each candidate is written and the count moves on only if it is kept: no branch on the
-    // owner or distance test (outcomes a predictor cannot learn).
-    int m = 0;
-    for (int oy = std::max(0, cy - 2); oy <= std::min(ny - 1, cy + 2); ++oy) {
-      // the cells ox = cx-2 .. cx+2 of one grid row are consecutive: one run of particles
-      const std::size_t c0 = static_cast<std::size_t>(oy) * nx + std::max(0, cx - 2);
-      const std::size_t c1 = static_cast<std::size_t>(oy) * nx + std::min(nx - 1, cx + 2) + 1;
-      const int k0 = cell_start_[c0], k1 = cell_start_[c1];
-      if (cand_.size() < static_cast<std::size_t>(m + (k1 - k0))) cand_.resize(2 * static_cast<std::size_t>(m + (k1 - k0)));
-      int* out = cand_.data();
-      for (int k = k0; k < k1; ++k) {
-        const Binned& q = binned_[static_cast<std::size_t>(k)];
-        const int j = q.index;
-        // owner of the pair (a < b): a if a + b is even, else b
-        const int a = std::min(ii, j), bb = std::max(ii, j);
-        const int owner = ((a + bb) & 1) == 0 ? a : bb;
-        const double dx = xi - q.x, dy = yi - q.y;
-        out[m] = j;
-        m += static_cast<int>((j != ii) & (owner == ii) & (dx * dx + dy * dy < reach2));
+  const int parts = std::max(1, run);
+  if (static_cast<int>(parts_.size()) < parts) parts_.resize(static_cast<std::size_t>(parts));
+  std::vector<std::exception_ptr> failure(static_cast<std::size_t>(parts));
+#pragma omp parallel num_threads(parts) if (parts > 1)
+  {
+    const int team = omp_get_num_threads();
+    for (int u = omp_get_thread_num(); u < parts; u += team) {
+      BuildPart& P = parts_[static_cast<std::size_t>(u)];
+      try {
+        P.nbr.clear();
+        P.max_row = 0;
+        const std::size_t i_lo = n * static_cast<std::size_t>(u) / static_cast<std::size_t>(parts);
+        const std::size_t i_hi = n * static_cast<std::size_t>(u + 1) / static_cast<std::size_t>(parts);
+        for (std::size_t i = i_lo; i < i_hi; ++i) {
+          if (cell_of_[i] < 0) continue;
+          const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
+          const int ii = static_cast<int>(i);
+          const double xi = x[i], yi = y[i];
+          // Each candidate is written and the count moves on only if it is kept: no branch on the
+          // owner or distance test (outcomes a predictor cannot learn).
+          int m = 0;
+          for (int oy = std::max(0, cy - 2); oy <= std::min(ny - 1, cy + 2); ++oy) {
+            // the cells ox = cx-2 .. cx+2 of one grid row are consecutive: one run of particles
+            const std::size_t c0 = static_cast<std::size_t>(oy) * nx + std::max(0, cx - 2);
+            const std::size_t c1 = static_cast<std::size_t>(oy) * nx + std::min(nx - 1, cx + 2) + 1;
+            const int k0 = cell_start_[c0], k1 = cell_start_[c1];
+            if (P.cand.size() < static_cast<std::size_t>(m + (k1 - k0))) P.cand.resize(2 * static_cast<std::size_t>(m + (k1 - k0)));
+            int* out = P.cand.data();
+            for (int k = k0; k < k1; ++k) {
+              const Binned& q = binned_[static_cast<std::size_t>(k)];
+              const int j = q.index;
+              // owner of the pair (a < b): a if a + b is even, else b
+              const int a = std::min(ii, j), bb = std::max(ii, j);
+              const int owner = ((a + bb) & 1) == 0 ? a : bb;
+              const double dx = xi - q.x, dy = yi - q.y;
+              out[m] = j;
+              m += static_cast<int>((j != ii) & (owner == ii) & (dx * dx + dy * dy < reach2));
+            }
+          }
+          std::sort(P.cand.begin(), P.cand.begin() + m);
+          P.nbr.insert(P.nbr.end(), P.cand.begin(), P.cand.begin() + m);
+          row_start_[i + 1] = m;
+          P.max_row = std::max(P.max_row, m);
+        }
+      } catch (...) {
+        failure[static_cast<std::size_t>(u)] = std::current_exception();
       }
     }
-    std::sort(cand_.begin(), cand_.begin() + m);
-    nbr_.insert(nbr_.end(), cand_.begin(), cand_.begin() + m);
-    max_row_ = std::max(max_row_, m);
   }
-  row_start_[n] = static_cast<int>(nbr_.size());
+  for (const auto& e : failure)
+    if (e) {
+      built_n_ = -1;  // (the list is half built: the next compute() builds it again)
+      std::rethrow_exception(e);
+    }
+  for (std::size_t i = 0; i < n; ++i) row_start_[i + 1] += row_start_[i];
+  max_row_ = 0;
+  if (parts == 1) {  // (one part: its buffer is the list)
+    nbr_.swap(parts_[0].nbr);
+    max_row_ = parts_[0].max_row;
+  }
+  if (parts > 1) nbr_.resize(static_cast<std::size_t>(row_start_[n]));
+  for (int u = 0, at = 0; parts > 1 && u < parts; ++u) {
+    const BuildPart& P = parts_[static_cast<std::size_t>(u)];
+    std::copy(P.nbr.begin(), P.nbr.end(), nbr_.begin() + at);
+    at += static_cast<int>(P.nbr.size());
+    max_row_ = std::max(max_row_, P.max_row);
+  }
   x0_.assign(x.begin(), x.end());
   y0_.assign(y.begin(), y.end());
   built_n_ = static_cast<long>(n);
@@ -257,7 +295,8 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
   fx.assign(n, 0.0);
   fy.assign(n, 0.0);
   if (n < 2) return;
-  if (!same_set || built_n_ != static_cast<long>(n) || moved(x, y)) rebuild(x, y);
+  const int run = run_threads > 0 ? std::min(run_threads, p_.threads) : p_.threads;
+  if (!same_set || built_n_ != static_cast<long>(n) || moved(x, y)) rebuild(x, y, run);
   pk_.resize(n);
   for (std::size_t i = 0; i < n; ++i) pk_[i] = {x[i], y[i], m[i].x, m[i].y};
   const int nt = p_.threads;
@@ -276,7 +315,6 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
   const Packed* pk = pk_.data();
   const int* rs = row_start_.data();
   const int* nb = nbr_.data();
-  const int run = run_threads > 0 ? std::min(run_threads, nt) : nt;
 #pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();

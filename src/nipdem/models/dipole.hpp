@@ -71,7 +71,7 @@ class PairSum {
   std::size_t listed_pairs() const { return nbr_.size(); }
 
  private:
-  void rebuild(std::span<const double> x, std::span<const double> y);
+  void rebuild(std::span<const double> x, std::span<const double> y, int run);  // rows in `run` parts (same list)
   bool moved(std::span<const double> x, std::span<const double> y) const;
   PairSumParams p_;
   long built_n_ = -1;
@@ -84,7 +84,8 @@ class PairSum {
   struct Binned { double x, y; int index; };  // a particle in cell order
   std::vector<int> cell_start_, cell_fill_, cell_of_;  // cell-list scratch (counting sort)
   std::vector<Binned> binned_;
-  std::vector<int> cand_;
+  struct BuildPart { std::vector<int> nbr, cand; int max_row = 0; };  // rebuild(): one part's rows
+  std::vector<BuildPart> parts_;
   int max_row_ = 0;                        // longest row of the list
   // Per part: one row's partners within r_c (separation, moment, index) and their forces
   struct RowScratch { std::vector<double> dx, dy, mx, my, gx, gy; std::vector<int> j; };
