@@ -89,6 +89,22 @@ std::set<std::pair<int, int>> listed(const geometry::NeighborList& nl) {
     for (int k = nl.row_start_[i]; k < nl.row_start_[i + 1]; ++k) s.insert({static_cast<int>(i), nl.nbr_[k]});
   return s;
 }
+// The pairs of discs of different bodies within r_i + r_j + extra of each other that `have`
+// lacks (brute force over all pairs): how many, and the first as "i,j".
+struct Unlisted { int count = 0; std::string first; };
+Unlisted unlisted_pairs(const test::DiscCloud& d, double extra, const std::set<std::pair<int, int>>& have) {
+  Unlisted u;
+  for (std::size_t i = 0; i < d.x.size(); ++i)
+    for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+      if (d.body[i] == d.body[j]) continue;
+      const double rc = d.r[i] + d.r[j] + extra;
+      const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
+      if (dx * dx + dy * dy < rc * rc && !have.count({static_cast<int>(i), static_cast<int>(j)})) {
+        if (u.count++ == 0) u.first = std::to_string(i) + "," + std::to_string(j);
+      }
+    }
+  return u;
+}
 }  // namespace
 
 // The row search runs in parallel over contiguous row ranges and is concatenated in order:
@@ -142,16 +158,8 @@ TEST(NeighborList, TwoLargestDisplacementCriterionNeverMissesAPair) {
     for (std::size_t i = 0; i < d.x.size(); ++i) geometry::NeighborList::top2(nl.displacement2(i, d.x[i], d.y[i]), d1, d2);
     EXPECT_EQ(nl.exceeds(d1, d2), nl.needs_rebuild(d.x, d.y));
     if (nl.exceeds(d1, d2)) { nl.rebuild(d.x, d.y, d.r, d.body, {}, p); ++rebuilds; }
-    const auto have = listed(nl);
-    for (std::size_t i = 0; i < d.x.size(); ++i)
-      for (std::size_t j = i + 1; j < d.x.size(); ++j) {
-        if (d.body[i] == d.body[j]) continue;
-        const double rc = d.r[i] + d.r[j] + p.extra_range;
-        const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
-        if (dx * dx + dy * dy < rc * rc) {
-          ASSERT_TRUE(have.count({static_cast<int>(i), static_cast<int>(j)})) << "pair " << i << "," << j << " step " << step;
-        }
-      }
+    const Unlisted u = unlisted_pairs(d, p.extra_range, listed(nl));
+    ASSERT_EQ(u.count, 0) << "pair " << u.first << " step " << step;
   }
   EXPECT_GT(rebuilds, 3);  // the walk does trigger rebuilds
 }
@@ -231,16 +239,8 @@ TEST(NeighborList, SkinsPerDiscCriterionNeverMissesAPair) {
       EXPECT_EQ(nl.exceeds(d1, d2), nl.needs_rebuild(d.x, d.y));
       if (nl.exceeds(d1, d2)) { nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h); ++rebuilds; }
       EXPECT_EQ(nl.per_disc(), per_disc);
-      const auto have = listed(nl);
-      for (std::size_t i = 0; i < d.x.size(); ++i)
-        for (std::size_t j = i + 1; j < d.x.size(); ++j) {
-          if (d.body[i] == d.body[j]) continue;
-          const double rc = d.r[i] + d.r[j] + p.extra_range;
-          const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j];
-          if (dx * dx + dy * dy < rc * rc) {
-            EXPECT_TRUE(have.count({static_cast<int>(i), static_cast<int>(j)})) << "pair " << i << "," << j << " step " << step;
-          }
-        }
+      const Unlisted u = unlisted_pairs(d, p.extra_range, listed(nl));
+      EXPECT_EQ(u.count, 0) << "first pair " << u.first << " step " << step;
     }
     return rebuilds;
   };
