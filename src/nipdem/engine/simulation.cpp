@@ -1075,11 +1075,11 @@ void Simulation::step() {
   time_ += dt;
   ++step_;
   if (ensure_neighbor_list(check_moves ? moved : -1)) list_room_ = 1;  // (built now: nothing moved yet)
-  // Without force providers nothing is added to the body forces after the contact sums, so the
-  // closing half kick runs in contact_forces()'s region (bitwise the loop below).
+  // The closing half kick runs where the body forces are complete: without force providers in
+  // contact_forces()' region, with them in provider_forces()' loop that adds their forces (the
+  // same operations either way).
   const bool kick_in_region = !newmark && forces_.empty();
   contact_forces(kick_in_region ? 0.5 * dt : 0.0, true);
-  // (with providers, the closing half kick runs in the loop that adds their forces)
   provider_forces(!newmark && !kick_in_region ? 0.5 * dt : 0.0);
   forces_valid_ = true;
   tuner_.step_done(omp_get_wtime() - t_start);

@@ -246,16 +246,17 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y, int 
     }
   for (std::size_t i = 0; i < n; ++i) row_start_[i + 1] += row_start_[i];
   max_row_ = 0;
-  if (parts == 1) {  // (one part: its buffer is the list)
-    nbr_.swap(parts_[0].nbr);
+  if (parts == 1) {
+    nbr_.swap(parts_[0].nbr);  // one part: its buffer is the list
     max_row_ = parts_[0].max_row;
-  }
-  if (parts > 1) nbr_.resize(static_cast<std::size_t>(row_start_[n]));
-  for (int u = 0, at = 0; parts > 1 && u < parts; ++u) {
-    const BuildPart& P = parts_[static_cast<std::size_t>(u)];
-    std::copy(P.nbr.begin(), P.nbr.end(), nbr_.begin() + at);
-    at += static_cast<int>(P.nbr.size());
-    max_row_ = std::max(max_row_, P.max_row);
+  } else {
+    nbr_.resize(static_cast<std::size_t>(row_start_[n]));
+    for (int u = 0, at = 0; u < parts; ++u) {
+      const BuildPart& P = parts_[static_cast<std::size_t>(u)];
+      std::copy(P.nbr.begin(), P.nbr.end(), nbr_.begin() + at);
+      at += static_cast<int>(P.nbr.size());
+      max_row_ = std::max(max_row_, P.max_row);
+    }
   }
   x0_.assign(x.begin(), x.end());
   y0_.assign(y.begin(), y.end());
