@@ -502,7 +502,18 @@ template <bool kAdhesion, bool kPeriodic, int kList>
     }
   };
   if constexpr (kList == 2) {
-    for (int k = 0; k < sub_n; ++k) test(sub[k].e, sub[k].i, sub[k].j);
+    // The discs of entry k + 8 are fetched ahead (their centres, velocities, force sums and the
+    // pair's history: scattered over ~2 MB, in L2 at best): the next entries' loads then
+    // overlap this one's arithmetic. Measured: stiffness_scale 0.01 (0.8 contacts per disc)
+    // 1.029x; 4 or 16 ahead, or only centres and velocities, were slower than 8.
+    for (int k = 0; k < sub_n; ++k) {
+      if (k + 8 < sub_n) {
+        const SubEntry& q = sub[k + 8];
+        __builtin_prefetch(&P[q.j]); __builtin_prefetch(&V[q.j]); __builtin_prefetch(&f[q.j], 1);
+        __builtin_prefetch(&eta[q.e]);
+      }
+      test(sub[k].e, sub[k].i, sub[k].j);
+    }
   } else {
     for (int e = rs[i0], e1 = rs[i1]; e < e1; ++e) test(e, own[e], nb[e]);
   }

@@ -316,6 +316,7 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
   const Packed* pk = pk_.data();
   const int* rs = row_start_.data();
   const int* nb = nbr_.data();
+  const int n_entries = rs[n];
 #pragma omp parallel num_threads(run)
   {
     const int t = omp_get_thread_num();
@@ -337,6 +338,7 @@ void PairSum::compute(std::span<const double> x, std::span<const double> y, std:
         // listed pairs are, at the presets' cut-off and skin): always written, counted if in.
         int cnt = 0;
         for (int e = rs[i]; e < rs[i + 1]; ++e) {
+          if (e + 8 < n_entries) __builtin_prefetch(&pk[nb[e + 8]]);  // (a partner 8 ahead: bench_nip 1.015x)
           const int j = nb[e];
           const Packed& pj = pk[j];
           const double dx = pi.x - pj.x, dy = pi.y - pj.y;
