@@ -238,7 +238,14 @@ PYBIND11_MODULE(_nipdem, m) {
           "body_array", [](py::object self, const std::string& name) { return body_array(Busy::check(self.cast<const Simulation&>()), name, self); },
           py::arg("name"))
       .def(
-          "disc_array", [](py::object self, const std::string& name) { return disc_array(Busy::check(self.cast<const Simulation&>()), name, self); },
+          "disc_array",
+          [](py::object self, const std::string& name) {
+            auto& s = self.cast<Simulation&>();
+            Busy::check(s);
+            // the adhesive part is filled when read (the engine's step does not keep it)
+            if (name == "fx_adhesion" || name == "fy_adhesion") s.run().sim().update_adhesive_parts();
+            return disc_array(s, name, self);
+          },
           py::arg("name"))
       .def("provider_names",
            [](const Simulation& s) {

@@ -108,6 +108,8 @@ def test_forces_per_kind(small_config):
     fx, fy = f["magnetic"]
     assert fx.shape == (sim.n_bodies,) and np.any(fx != 0)
     assert f["adhesion"][0].shape == (sim.n_discs,)
+    # the Hamaker part is computed when read (the engine's step does not keep it): not all zero
+    assert np.any(f["adhesion"][1] != 0) and np.all(np.isfinite(f["adhesion"][0]))
     assert len(sim.voltages()) == 0 and len(sim.charges()) == 0  # no [electric] in the clean state
 
 

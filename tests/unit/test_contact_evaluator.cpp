@@ -178,6 +178,7 @@ TEST(ContactEvaluator, EnginePairAndWallLoopsApplyTheEvaluator) {
   sim.add_body(test::disc_body(kR1, 1700, {0, kR1 - xi_w}));
   sim.add_body(test::disc_body(kR2, 1700, {0, kR1 - xi_w + kR1 + kR2 - xi_p}));
   sim.compute_forces();
+  sim.update_adhesive_parts();
   EXPECT_EQ(sim.contacts(), 2);
   TangentialState s0{}, s1{};
   const ContactForce pair = contact_force<true>(kCp, kHp, kR1, kR2, xi_p, 0.0, 0.0, 0.0, kDt, s0);
@@ -195,4 +196,65 @@ TEST(ContactEvaluator, EnginePairAndWallLoopsApplyTheEvaluator) {
   EXPECT_EQ(d.tq[0], 0.0);
   const double e = contact_energy(kCp, xi_p, 0.0) + contact_energy(tw.contact, xi_w, 0.0);
   EXPECT_NEAR(sim.energy().elastic, e, 1e-9 * e);  // overlaps from positions again: as above
+}
+
+// Simulation::update_adhesive_parts (the Hamaker part of each disc's force, filled on request,
+// not by each step): at rest, the part equals the force with adhesion minus the force of the
+// same state without it (the springs and dashpots are the same, eq. 2.3.2 is the difference),
+// for pairs overlapping, apart within the cut-off and beyond it, across a periodic seam, against
+// a wall, on 1 and 2 threads; the pairs' parts sum to zero (actio = reactio).
+TEST(ContactEvaluator, AdhesivePartsAreTheForceWithAdhesionMinusWithout) {
+  // A row of 15 discs (radius 3 um) 2 nm above a floor, with surface gaps cycling over overlaps,
+  // gaps within the 4 nm cut-off and beyond it, in a periodic box that closes the row across the
+  // seam with a 1 nm gap.
+  const double gaps[] = {-4e-9, -1e-9, 0.5e-9, 2e-9, 3.9e-9, 5e-9};
+  const double r = 3e-6;
+  std::vector<double> xs{1e-6};
+  for (int k = 0; k < 14; ++k) xs.push_back(xs.back() + 2 * r + gaps[k % 6]);
+  const double box = xs.back() + 2 * r + 1e-9 - xs.front();  // x_lo = 0: the seam gap is 1 nm
+  for (int threads : {1, 2}) {
+    auto make = [&](double hamaker_J) {
+      engine::EngineParams p;
+      engine::Interaction tt{.name = "tt", .contact = kCp, .adhesion = kHp};
+      tt.adhesion.hamaker_J = hamaker_J;
+      engine::Interaction tw = tt;
+      tw.name = "tw";
+      p.interactions = {tt, tw};
+      p.dt = kDt;
+      p.threads = threads;
+      p.periodic_x = true;
+      p.x_lo = 0.0;
+      p.x_hi = box;
+      return engine::Simulation(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+    };
+    engine::Simulation on = make(kHp.hamaker_J), off = make(0.0);
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+      const double y = r + 2e-9;
+      on.add_body(test::disc_body(r, 1700, {xs[k], y}));
+      off.add_body(test::disc_body(r, 1700, {xs[k], y}));
+    }
+    on.compute_forces();
+    off.compute_forces();
+    on.update_adhesive_parts();
+    const auto& a = on.discs();
+    const auto& b = off.discs();
+    double fmax = 0.0, sum_x = 0.0;
+    int nonzero = 0;
+    for (std::size_t i = 0; i < a.x.size(); ++i) fmax = std::max({fmax, std::fabs(a.fx[i]), std::fabs(a.fy[i])});
+    for (std::size_t i = 0; i < a.x.size(); ++i) {
+      // each force is a sum of at most 3 terms of size <= fmax: a few roundings of it
+      EXPECT_NEAR(a.fax[i], a.fx[i] - b.fx[i], 1e-14 * fmax) << "disc " << i << ", " << threads << " threads";
+      EXPECT_NEAR(a.fay[i], a.fy[i] - b.fy[i], 1e-14 * fmax) << "disc " << i << ", " << threads << " threads";
+      sum_x += a.fax[i];
+      nonzero += a.fax[i] != 0.0 ? 1 : 0;
+    }
+    EXPECT_NEAR(sum_x, 0.0, 1e-14 * fmax * static_cast<double>(a.x.size()));  // the floor pulls along y only
+    EXPECT_GE(nonzero, 12);              // 13 of the 15 discs have a partner within the cut-off
+    // disc 0: pulled to +x by disc 1 (overlapping: at D0) and to -x across the seam (1 nm); the
+    // gaps are differences of positions ~1e-4 m (rounding ~1e-20 m, 1e-11 of the nm distances)
+    const double want = hamaker_force(kHp, r, r, -4e-9) - hamaker_force(kHp, r, r, 1e-9);
+    EXPECT_NEAR(a.fax.front(), want, 1e-9 * want);
+    const double floor = hamaker_force(kHp, r, kInf, 2e-9);  // the floor pulls each disc down
+    for (std::size_t i = 0; i < a.x.size(); ++i) EXPECT_NEAR(a.fay[i], -floor, 1e-9 * floor) << "disc " << i;
+  }
 }

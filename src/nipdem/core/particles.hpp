@@ -66,7 +66,9 @@ struct DiscStore {
   std::vector<double> wx, wy;  // current world-frame offset from the body centre of mass [m]
   // Force [N] and torque about the disc centre [N m] accumulated in one evaluation.
   std::vector<double> fx, fy, tq;
-  std::vector<double> fax, fay;  // adhesive part of (fx, fy), kept for output [N]
+  // Adhesive part of (fx, fy) [N], for output: filled on request (Simulation::update_adhesive_parts),
+  // not by each force evaluation.
+  std::vector<double> fax, fay;
   // Wall contact history: key (-1 = empty), tangential stretch, sliding flag.
   std::vector<std::int64_t> wall_key;    // kWallSlots per disc
   std::vector<double> wall_eta;          // kWallSlots per disc

@@ -421,14 +421,14 @@ void Simulation::update_thread_split() {
 }
 
 // The pair kernel: rows [i0, i1) of the half list. Reads only the packed copies (plus the
-// list and its history), accumulates force and torque about the disc centre into f and the
-// adhesive part into fa (2 per disc). One loop over the entries: a distance test, and for a
+// list and its history), accumulates force and torque about the disc centre into f (the adhesive
+// part is not kept apart: update_adhesive_parts()). One loop over the entries: a distance test, and for a
 // pair within contact or adhesion range the law at once (detail::pair_contact) and its sums
 // into both discs, in list order (a row's own sum is accumulated apart and added when the row
 // ends). The history of a pair out of range is cleared.
 // (Kept out of line: inlined into contact_forces' parallel region, GCC 12 made it ~3 % slower.)
 template <bool kAdhesion, bool kPeriodic, int kList>
-[[gnu::noinline]] void Simulation::pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc_out,
+[[gnu::noinline]] void Simulation::pair_rows(int i0, int i1, PackedForce* f, std::int64_t& nc_out,
                                              SubEntry* sub, int& sub_n) {
   const ContactParams cp = params_.interactions[0].contact;
   const models::HamakerParams hp = params_.interactions[0].adhesion;
@@ -455,12 +455,11 @@ template <bool kAdhesion, bool kPeriodic, int kList>
   std::int64_t nc = 0;
   // the row whose own sum is open, and that sum
   int row = -1;
-  double fxi = 0.0, fyi = 0.0, tqi = 0.0, faxi = 0.0, fayi = 0.0;
+  double fxi = 0.0, fyi = 0.0, tqi = 0.0;
   auto close_row = [&]() __attribute__((always_inline)) {
     if (row < 0) return;
     f[row].fx += fxi; f[row].fy += fyi; f[row].tq += tqi;
-    if constexpr (kAdhesion) { fa[2 * row] += faxi; fa[2 * row + 1] += fayi; }
-    fxi = fyi = tqi = faxi = fayi = 0.0;
+    fxi = fyi = tqi = 0.0;
   };
   const double margin = sub_margin_;
   const double* G = kList == 1 && sub_per_disc_ ? sub_g_.data() : nullptr;  // margins per disc
@@ -489,10 +488,6 @@ template <bool kAdhesion, bool kPeriodic, int kList>
       nc += static_cast<std::int64_t>(touching);
       fxi += fx; fyi += fy; tqi += ti;
       f[j].fx -= fx; f[j].fy -= fy; f[j].tq += tj;
-      if constexpr (kAdhesion) {
-        faxi -= fax; fayi -= fay;
-        fa[2 * j] += fax; fa[2 * j + 1] += fay;
-      }
     } else if ((sl[e] != 0) | (eta[e] != 0.0)) {
       // History of a pair out of range is reset where there is some (rare: a contact that just
       // opened); most stay clean, and a read keeps their cache lines clean (no write-back). A
@@ -545,12 +540,8 @@ void Simulation::contact_forces(double kick_h, bool packed) {
   // Every buffer the region writes is sized here: nothing allocates inside it (an exception must
   // not cross an OpenMP region), except the wall queries' scratch, whose failures are carried out.
   if (static_cast<int>(tforce_.size()) != nt) tforce_.assign(nt, {});
-  if (static_cast<int>(tadh_.size()) != nt) tadh_.assign(nt, {});
   for (auto& buf : tforce_)
     if (static_cast<int>(buf.size()) < n) buf.resize(n);
-  if (adh)
-    for (auto& ab : tadh_)
-      if (static_cast<int>(ab.size()) < 2 * n) ab.resize(2 * n);
   thread_nc_.assign(nt, 0);
   if (has_walls) thread_fail_.assign(nt, nullptr);
   // per disc and wall: the roller period the disc was last found in (a hint for the query,
@@ -598,11 +589,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
   const bool take_near = has_walls && list_mode == 1 && walls_.size() <= 32;
   if (take_near) wall_near_.assign(static_cast<std::size_t>(n), 0u);
   int unused_n = 0;
-  auto run_rows = [&]<bool A, bool Per>(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc, SubEntry* sub,
-                                         int& sn) {
-    if (list_mode == 2) pair_rows<A, Per, 2>(i0, i1, f, fa, nc, sub, sn);
-    else if (list_mode == 1) pair_rows<A, Per, 1>(i0, i1, f, fa, nc, sub, sn);
-    else pair_rows<A, Per, 0>(i0, i1, f, fa, nc, sub, sn);
+  auto run_rows = [&]<bool A, bool Per>(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sn) {
+    if (list_mode == 2) pair_rows<A, Per, 2>(i0, i1, f, nc, sub, sn);
+    else if (list_mode == 1) pair_rows<A, Per, 1>(i0, i1, f, nc, sub, sn);
+    else pair_rows<A, Per, 0>(i0, i1, f, nc, sub, sn);
   };
   const int run = team();  // threads that run the nt parts (results depend on nt only)
   const bool simple_blocks = simple_valid_ && simple_prefix_.size() == static_cast<std::size_t>(nb) + 1;
@@ -622,17 +612,16 @@ void Simulation::contact_forces(double kick_h, bool packed) {
       // over them per step instead of two), and they start zero when they are allocated.
       auto& buf = tforce_[u];
       const int lo = split_[u];
-      double* fa = adh ? tadh_[u].data() : nullptr;
       std::int64_t nc = 0;
       const int i1 = split_[u + 1];
       SubEntry* sub = list_mode > 0 ? sub_[u].data() : nullptr;
       int& sn = list_mode > 0 ? sub_n_[u] : unused_n;
       if (adh) {
-        if (periodic) run_rows.template operator()<true, true>(lo, i1, buf.data(), fa, nc, sub, sn);
-        else run_rows.template operator()<true, false>(lo, i1, buf.data(), fa, nc, sub, sn);
+        if (periodic) run_rows.template operator()<true, true>(lo, i1, buf.data(), nc, sub, sn);
+        else run_rows.template operator()<true, false>(lo, i1, buf.data(), nc, sub, sn);
       } else {
-        if (periodic) run_rows.template operator()<false, true>(lo, i1, buf.data(), fa, nc, sub, sn);
-        else run_rows.template operator()<false, false>(lo, i1, buf.data(), fa, nc, sub, sn);
+        if (periodic) run_rows.template operator()<false, true>(lo, i1, buf.data(), nc, sub, sn);
+        else run_rows.template operator()<false, false>(lo, i1, buf.data(), nc, sub, sn);
       }
       thread_nc_[u] = nc;
     }
@@ -668,41 +657,24 @@ void Simulation::contact_forces(double kick_h, bool packed) {
           if (m[q]) { ++parts; only = u; break; }
       }
       double* dfx = d_.fx.data(); double* dfy = d_.fy.data(); double* dtq = d_.tq.data();
-      double* dfax = d_.fax.data(); double* dfay = d_.fay.data();
       if (parts == 1) {  // (every disc is in its own part's range: that one)
         PackedForce* g = tforce_[only].data();
-        if (adh) {
-          double* h = tadh_[only].data();
-          for (int i = k0; i < k1; ++i) {
-            double a = 0.0, b = 0.0, c = 0.0, p = 0.0, q = 0.0;
-            a += g[i].fx; b += g[i].fy; c += g[i].tq; p += h[2 * i]; q += h[2 * i + 1];
-            g[i] = PackedForce{0.0, 0.0, 0.0, 0.0};
-            h[2 * i] = 0.0; h[2 * i + 1] = 0.0;
-            dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = p; dfay[i] = q;
-          }
-        } else {
-          for (int i = k0; i < k1; ++i) {
-            double a = 0.0, b = 0.0, c = 0.0;
-            a += g[i].fx; b += g[i].fy; c += g[i].tq;
-            g[i] = PackedForce{0.0, 0.0, 0.0, 0.0};
-            dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = 0.0; dfay[i] = 0.0;
-          }
+        for (int i = k0; i < k1; ++i) {
+          double a = 0.0, b = 0.0, c = 0.0;
+          a += g[i].fx; b += g[i].fy; c += g[i].tq;
+          g[i] = PackedForce{0.0, 0.0, 0.0, 0.0};
+          dfx[i] = a; dfy[i] = b; dtq[i] = c;
         }
       } else {
         for (int i = k0; i < k1; ++i) {
-          double a = 0, b = 0, c = 0, p = 0, q = 0;
+          double a = 0, b = 0, c = 0;
           for (int u = 0; u < nt; ++u) {
             if (!part_touch_[static_cast<std::size_t>(u) * touch_blocks_ + (i >> kTouchShift)]) continue;
             PackedForce& g = tforce_[u][i];
             a += g.fx; b += g.fy; c += g.tq;
             g = PackedForce{0.0, 0.0, 0.0, 0.0};
-            if (adh) {
-              double* h = &tadh_[u][2 * i];
-              p += h[0]; q += h[1];
-              h[0] = 0.0; h[1] = 0.0;
-            }
           }
-          dfx[i] = a; dfy[i] = b; dtq[i] = c; dfax[i] = p; dfay[i] = q;
+          dfx[i] = a; dfy[i] = b; dtq[i] = c;
         }
       }
       // then each disc's wall forces, added to its pair sums
@@ -846,7 +818,7 @@ void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geomet
   const Vec2 c{d_.x[i], d_.y[i]};
   const double r = d_.r[i];
   int nnew = 0;
-  double fx = 0, fy = 0, tq = 0, fax = 0, fay = 0;
+  double fx = 0, fy = 0, tq = 0;
   bool touched = false;
   for (std::size_t w = 0; w < nw; ++w) {
     if (!(mask >> (w & 31) & 1u)) continue;  // (nw > 32: every bit set)
@@ -893,7 +865,6 @@ void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geomet
         tq += -l * cf.ft;
       }
       fnx -= cf.fa * h.normal.x; fny -= cf.fa * h.normal.y;
-      fax -= cf.fa * h.normal.x; fay -= cf.fa * h.normal.y;
       fx += fnx; fy += fny;
     }
   }
@@ -905,7 +876,7 @@ void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geomet
       d_.wall_slide[i * kWallSlots + q] = q < nnew ? new_sl[q] : 0;
     }
   }
-  if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; d_.fax[i] += fax; d_.fay[i] += fay; }
+  if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; }
 }
 
 // Total force and torque about the centre of mass of body b from its discs, plus gravity.
@@ -951,6 +922,67 @@ void Simulation::compute_forces() {
   contact_forces();
   provider_forces(0.0);
   forces_valid_ = true;
+}
+
+// The Hamaker part (eq. 2.3.2) of each disc's force, from the present positions: the same pairs
+// (listed, within r_i + r_j + reach) and wall features (within the wall's reach) that the force
+// evaluation takes adhesion from, each attraction -fa along the outward normal of its surface,
+// in the pair kernel's order on one thread (other thread counts sum the parts in another order:
+// rounding level). The pair kernel used to
+// sum this part into per-thread buffers at every step for an output read a few times per run:
+// at 0.8 contacts per disc that was ~4 % of bench_nip's step (docs/performance.md, fourteenth
+// pass).
+void Simulation::update_adhesive_parts() {
+  if (!forces_valid_) {
+    update_disc_positions(0, b_.x.size());
+    compute_forces();  // (makes the list hold every pair in range)
+  }
+  const std::size_t n = d_.x.size();
+  std::fill(d_.fax.begin(), d_.fax.end(), 0.0);
+  std::fill(d_.fay.begin(), d_.fay.end(), 0.0);
+  const models::HamakerParams hp = params_.interactions[0].adhesion;
+  const double L = params_.x_hi - params_.x_lo;
+  if (hp.hamaker_J != 0.0 && nlist_.size() == n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      double ax = 0.0, ay = 0.0;  // row i's own sum, added when the row ends (as the pair kernel does)
+      for (int e = nlist_.row_start_[i]; e < nlist_.row_start_[i + 1]; ++e) {
+        const auto j = static_cast<std::size_t>(nlist_.nbr_[e]);
+        double dx = d_.x[i] - d_.x[j];
+        const double dy = d_.y[i] - d_.y[j];
+        if (params_.periodic_x) {  // minimum image, as the pair kernel takes it
+          dx = dx > 0.5 * L ? dx - L : dx;
+          dx = dx < -0.5 * L ? dx + L : dx;
+        }
+        const double rc = (d_.r[i] + d_.r[j]) + pair_reach_;
+        const double d2 = dx * dx + dy * dy;
+        if (!(d2 < rc * rc)) continue;
+        const double dist = std::sqrt(d2);
+        const double fa = models::hamaker_force(hp, d_.r[i], d_.r[j], dist - (d_.r[i] + d_.r[j]));
+        const double inv = 1.0 / dist;
+        const double nx = dx * inv, ny = dy * inv;  // from j to i
+        ax -= fa * nx; ay -= fa * ny;
+        d_.fax[j] += fa * nx; d_.fay[j] += fa * ny;
+      }
+      d_.fax[i] += ax; d_.fay[i] += ay;
+    }
+  }
+  std::vector<geometry::WallHit> hits;
+  for (std::size_t w = 0; w < walls_.size(); ++w) {
+    const auto& wall = walls_[w];
+    const models::HamakerParams& wh = params_.interactions[wall.interaction].adhesion;
+    if (wh.hamaker_J == 0.0) continue;
+    const double reach = w < wall_reach_.size() ? wall_reach_[w] : wh.cutoff_m;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2 c{d_.x[i], d_.y[i]};
+      if (!wall.may_touch(c, d_.r[i], reach)) continue;
+      hits.clear();
+      wall.query(c, d_.r[i], reach, hits);
+      for (const auto& h : hits) {
+        const double fa = models::hamaker_force(wh, d_.r[i], kInf, h.gap);
+        d_.fax[i] -= fa * h.normal.x; d_.fay[i] -= fa * h.normal.y;
+      }
+    }
+  }
 }
 
 void Simulation::step() {

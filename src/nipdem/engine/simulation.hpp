@@ -157,6 +157,10 @@ class Simulation {
   void step();
   // Evaluates forces for the current state without moving anything.
   void compute_forces();
+  // Fills discs().fax, fay with the adhesive (Hamaker) part of each disc's force at the present
+  // positions (evaluating the forces first if they are not valid). step() does not keep them:
+  // call this before reading them (frames, Python's fx_adhesion).
+  void update_adhesive_parts();
 
   double time() const { return time_; }
   std::int64_t step_count() const { return step_; }
@@ -222,7 +226,7 @@ class Simulation {
   // kList: 0 = test every entry of rows [i0, i1); 1 = the same, and take the sublist of those
   // rows into sub/sub_n; 2 = test only the sublist sub[0, sub_n).
   template <bool kAdhesion, bool kPeriodic, int kList>
-  void pair_rows(int i0, int i1, PackedForce* f, double* fa, std::int64_t& nc, SubEntry* sub, int& sub_n);
+  void pair_rows(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sub_n);
   bool sublist_moved() const;  // two largest displacements since the sublist exceed its margin
 
   EngineParams params_;
@@ -240,7 +244,6 @@ class Simulation {
   std::vector<PackedDisc> pdisc_;
   std::vector<PackedVel> pvel_;
   std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers
-  std::vector<std::vector<double>> tadh_;         // per-thread adhesive part (fax, fay interleaved)
   // Thread t owns list rows [split_[t], split_[t+1]) and writes its own discs and their listed
   // partners (j > i, which may lie anywhere after split_[t+1]: across a periodic seam, the far
   // end of the order). part_touch_[t * touch_blocks_ + (i >> kTouchShift)] is 1 if it may write

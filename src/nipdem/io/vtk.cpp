@@ -62,6 +62,7 @@ std::string write_vtp(const std::filesystem::path& dir, int index, const engine:
   array_open(s, "Float64", "speed_m_per_s", 1);
   for (std::size_t i = 0; i < n; ++i) s += fmt::format("{:.6g} ", std::hypot(vx[i], vy[i]));
   array_close(s);
+  // (the adhesive part fax, fay as the caller filled it: Simulation::update_adhesive_parts)
   array_open(s, "Float64", "force_contact_N", 3);
   for (std::size_t i = 0; i < n; ++i) s += fmt::format("{:.6g} {:.6g} 0 ", d.fx[i] - d.fax[i], d.fy[i] - d.fay[i]);
   array_close(s);

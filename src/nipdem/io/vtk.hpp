@@ -14,7 +14,8 @@ namespace nipdem::io {
 // Writes DIR/particles/frame_<index>.vtp for the current state (atomic) and returns its path
 // relative to DIR. Point data: radius_m, body_id, tag, velocity_m_per_s, speed_m_per_s,
 // force_contact_N, force_adhesion_N (per disc), force_<provider>_N and force_total_N (per
-// body, repeated on its discs). Field data: time_s and each wall's rotation angle.
+// body, repeated on its discs). Field data: time_s and each wall's rotation angle. The adhesive
+// part is the discs' fax, fay: call sim.update_adhesive_parts() first.
 std::string write_vtp(const std::filesystem::path& dir, int index, const engine::Simulation& sim);
 // Writes DIR/particles.pvd listing (time, relative path) pairs (atomic).
 void write_pvd(const std::filesystem::path& dir, const std::vector<std::pair<double, std::string>>& frames);

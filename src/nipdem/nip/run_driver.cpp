@@ -131,6 +131,7 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
     auto& sim = run.sim();
     if (cfg.vtk) {
       const int idx = static_cast<int>(frames.size());
+      sim.update_adhesive_parts();  // (the frame's adhesive part; step() does not keep it)
       frames.emplace_back(sim.time(), io::write_vtp(out, idx, sim));
       io::write_pvd(out, frames);
       json fj = json::array();
