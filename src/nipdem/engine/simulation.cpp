@@ -966,22 +966,26 @@ void Simulation::update_adhesive_parts() {
       d_.fax[i] += ax; d_.fay[i] += ay;
     }
   }
+  // each disc's walls summed apart and then added, in wall order (as wall_disc does)
   std::vector<geometry::WallHit> hits;
-  for (std::size_t w = 0; w < walls_.size(); ++w) {
-    const auto& wall = walls_[w];
-    const models::HamakerParams& wh = params_.interactions[wall.interaction].adhesion;
-    if (wh.hamaker_J == 0.0) continue;
-    const double reach = w < wall_reach_.size() ? wall_reach_[w] : wh.cutoff_m;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec2 c{d_.x[i], d_.y[i]};
-      if (!wall.may_touch(c, d_.r[i], reach)) continue;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2 c{d_.x[i], d_.y[i]};
+    double ax = 0.0, ay = 0.0;
+    bool any = false;
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+      const auto& wall = walls_[w];
+      const models::HamakerParams& wh = params_.interactions[wall.interaction].adhesion;
+      const double reach = w < wall_reach_.size() ? wall_reach_[w] : (wh.hamaker_J != 0.0 ? wh.cutoff_m : 0.0);
+      if (wh.hamaker_J == 0.0 || !wall.may_touch(c, d_.r[i], reach)) continue;
       hits.clear();
       wall.query(c, d_.r[i], reach, hits);
       for (const auto& h : hits) {
         const double fa = models::hamaker_force(wh, d_.r[i], kInf, h.gap);
-        d_.fax[i] -= fa * h.normal.x; d_.fay[i] -= fa * h.normal.y;
+        ax -= fa * h.normal.x; ay -= fa * h.normal.y;
+        any = true;
       }
     }
+    if (any) { d_.fax[i] += ax; d_.fay[i] += ay; }
   }
 }
 
