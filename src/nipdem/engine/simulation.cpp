@@ -928,15 +928,15 @@ void Simulation::compute_forces() {
 // (listed, within r_i + r_j + reach) and wall features (within the wall's reach) that the force
 // evaluation takes adhesion from, each attraction -fa along the outward normal of its surface,
 // in the pair kernel's order on one thread (other thread counts sum the parts in another order:
-// rounding level). The pair kernel used to
-// sum this part into per-thread buffers at every step for an output read a few times per run:
-// at 0.8 contacts per disc that was ~4 % of bench_nip's step (docs/performance.md, fourteenth
-// pass).
+// rounding level). The pair kernel used to sum this part into per-thread buffers at every step,
+// for an output read a few times per run: at 0.8 contacts per disc that was ~4 % of bench_nip's
+// step (docs/performance.md, fourteenth pass).
 void Simulation::update_adhesive_parts() {
   if (!forces_valid_) {
     update_disc_positions(0, b_.x.size());
     compute_forces();  // (makes the list hold every pair in range)
   }
+  prepare_walls();  // the walls' reach and rotation, as the force evaluation has them
   const std::size_t n = d_.x.size();
   std::fill(d_.fax.begin(), d_.fax.end(), 0.0);
   std::fill(d_.fay.begin(), d_.fay.end(), 0.0);
@@ -975,7 +975,7 @@ void Simulation::update_adhesive_parts() {
     for (std::size_t w = 0; w < walls_.size(); ++w) {
       const auto& wall = walls_[w];
       const models::HamakerParams& wh = params_.interactions[wall.interaction].adhesion;
-      const double reach = w < wall_reach_.size() ? wall_reach_[w] : (wh.hamaker_J != 0.0 ? wh.cutoff_m : 0.0);
+      const double reach = wall_reach_[w];
       if (wh.hamaker_J == 0.0 || !wall.may_touch(c, d_.r[i], reach)) continue;
       hits.clear();
       wall.query(c, d_.r[i], reach, hits);
