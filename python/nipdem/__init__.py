@@ -60,17 +60,10 @@ def _toml_literal(value):
 
 
 def _write_atomic(path, content):
-    """The library's atomic write (temp file "<path>.tmp.<pid>", fsync, rename). When the
-    rename fails (e.g. `path` is a folder) the library leaves its temp file behind; it is
-    removed here, so a failed write leaves nothing."""
-    path = _os.fspath(path)
-    try:
-        _nipdem.write_file_atomic(path, content)
-    except BaseException:
-        tmp = f"{path}.tmp.{_os.getpid()}"
-        if _os.path.isfile(tmp):
-            _os.remove(tmp)
-        raise
+    """The library's atomic write (temp file "<path>.tmp.<pid>", fsync, rename). A path that
+    cannot be an output file (a folder, a device, empty, an unwritable folder) raises
+    ValueError naming it; a failed write leaves nothing behind (io::write_file_atomic)."""
+    _nipdem.write_file_atomic(_os.fspath(path), content)
 
 
 def _leaves(table, prefix=""):

@@ -86,12 +86,12 @@ def test_save_and_load_round_trip(tmp_path):
 def test_failed_save_leaves_nothing(tmp_path):
     cfg = nipdem.preset("black")
     (tmp_path / "a_folder").mkdir()
-    with pytest.raises(RuntimeError) as e:
-        cfg.save(tmp_path / "a_folder")  # cannot replace a folder by a file
+    with pytest.raises(ValueError) as e:
+        cfg.save(tmp_path / "a_folder")  # cannot replace a folder by a file: invalid input
     assert "a_folder" in str(e.value)
     assert os.listdir(tmp_path) == ["a_folder"]  # no temp file left beside it
     (tmp_path / "a_file").write_text("x")
-    with pytest.raises(RuntimeError):
+    with pytest.raises(ValueError):  # its folder cannot be made: a file is in the way
         cfg.save(tmp_path / "a_file" / "c.toml")
     assert sorted(os.listdir(tmp_path)) == ["a_file", "a_folder"]
     assert (tmp_path / "a_file").read_text() == "x"

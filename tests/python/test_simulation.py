@@ -212,7 +212,7 @@ def test_invalid_config_and_io_errors(tmp_path, small_config):
         nipdem.Simulation(tmp_path / "absent.toml")
     sim = nipdem.Simulation(small_config)
     (tmp_path / "ckpt").mkdir()
-    with pytest.raises(RuntimeError):
+    with pytest.raises(ValueError):  # a folder cannot be replaced by the checkpoint file
         sim.save_checkpoint(tmp_path / "ckpt")
     assert os.listdir(tmp_path) == ["ckpt"]
     with pytest.raises(ValueError):

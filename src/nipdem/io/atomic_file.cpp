@@ -1,6 +1,8 @@
 #include "nipdem/io/atomic_file.hpp"
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -35,14 +37,30 @@ KillAtWrite& kill_at_write() {
 }
 }  // namespace
 
+void check_replaceable(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) throw InputError("output path is empty (name a file to write)");
+  std::error_code ec;
+  const auto st = fs::symlink_status(path, ec);  // a symlink itself is replaced, not its target
+  if (ec || !fs::exists(st) || fs::is_regular_file(st) || fs::is_symlink(st)) return;
+  throw InputError(path.string() + (fs::is_directory(st)
+                                        ? ": is a folder; nipdem writes its output file there by replacing what is at that path, and will not replace a folder (name a file)"
+                                        : ": is not a regular file (a device, FIFO or socket); nipdem writes its output by replacing what is at that path, and will not replace that (name a file)"));
+}
+
 void write_file_atomic(const std::filesystem::path& path, std::string_view content) {
   namespace fs = std::filesystem;
-  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  check_replaceable(path);
+  if (path.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(path.parent_path(), ec);
+    if (ec) throw InputError(path.string() + ": cannot create its folder " + path.parent_path().string() + " (" + ec.message() + ")");
+  }
   fs::path tmp = path;
   tmp += ".tmp." + std::to_string(::getpid());
   {
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f) throw std::runtime_error("cannot open '" + tmp.string() + "' for writing");
+    if (!f) throw InputError(path.string() + ": cannot write there (cannot create '" + tmp.string() + "': " + std::strerror(errno) + ")");
     const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size() &&
                     std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
     std::fclose(f);
@@ -54,7 +72,12 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
   auto& k = kill_at_write();
   const bool kill_now = k.n > 0 && ++k.count == k.n;
   if (kill_now && k.before) ::raise(SIGKILL);
-  fs::rename(tmp, path);
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {  // (the path changed since the check, or a filesystem that refuses): no temp file left behind
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot replace '" + path.string() + "' by its new content: " + ec.message());
+  }
   if (kill_now) ::raise(SIGKILL);
 }
 

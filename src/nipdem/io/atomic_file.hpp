@@ -8,8 +8,16 @@
 namespace nipdem::io {
 
 // Writes `content` to `path` atomically (temp file in the same folder, fsync, rename).
-// Throws std::runtime_error naming the path on failure; the old file is left untouched.
+// Throws InputError naming the path if it cannot be an output file (see check_replaceable, or
+// its folder cannot be made or written), std::runtime_error naming it if writing fails (disk
+// full); the old file is left untouched and no temp file is left behind.
 void write_file_atomic(const std::filesystem::path& path, std::string_view content);
+
+// Throws InputError naming `path` unless an output file may be written there by replacing
+// what is at it: nothing, a regular file or a symlink (replaced itself, its target untouched).
+// An empty path, a folder, a device, a FIFO or a socket is refused: a rename over a device
+// node would replace it with a regular file (as root, /dev/null).
+void check_replaceable(const std::filesystem::path& path);
 
 // Largest input file (config, CSV, map, pattern, JSON) nipdem reads [bytes]: far above any real
 // one, small enough that a wrong path (a disk image, a log) is refused before it is read.
