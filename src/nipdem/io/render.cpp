@@ -224,13 +224,22 @@ void render_frame(const Frame& f, const json& geo, const RenderOptions& opt, con
   cairo_stroke(cr);
   text("100 µm", X(x0) + 0.5 * bar, by + 30, 0.5);
   cairo_destroy(cr);
+  check_replaceable(png);
   fs::create_directories(png.parent_path());
   fs::path tmp = png;
   tmp += ".tmp." + std::to_string(::getpid());
   const cairo_status_t st = cairo_surface_write_to_png(surf, tmp.c_str());
   cairo_surface_destroy(surf);
-  if (st != CAIRO_STATUS_SUCCESS) throw std::runtime_error("cannot write " + png.string() + ": " + cairo_status_to_string(st));
-  fs::rename(tmp, png);
+  std::error_code ec;
+  if (st != CAIRO_STATUS_SUCCESS) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot write " + png.string() + ": " + cairo_status_to_string(st));
+  }
+  fs::rename(tmp, png, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot replace " + png.string() + " by the new picture");
+  }
 }
 
 int render_run(const fs::path& dir, const RenderOptions& opt) {
@@ -238,10 +247,32 @@ int render_run(const fs::path& dir, const RenderOptions& opt) {
     throw InputError(dir.string() + ": not a nipdem run folder (no summary.json / frames.json)");
   if (opt.color_by != "speed" && opt.color_by != "force")
     throw_input("render", "--color-by", opt.color_by, "unknown colouring", "speed, force");
-  json geometry;
-  if (fs::exists(dir / "summary.json")) geometry = json::parse(read_file(dir / "summary.json"))["geometry"];
-  else throw InputError(dir.string() + ": summary.json missing (run not finished); render needs its geometry");
-  const json frames = json::parse(read_file(dir / "frames.json"));
+  if (!(opt.color_max >= 0.0 && std::isfinite(opt.color_max)))
+    throw_input("render", "--color-max", fmt::format("{:g}", opt.color_max), "must be a finite value >= 0",
+                "[0, inf) (0: automatic scale)");
+  // Both files are a run's own outputs; anything else in their place is refused naming the file
+  // (valid JSON of another shape too: it would otherwise fail deep in the drawing, exit 1).
+  auto parse = [](const fs::path& p) {
+    try {
+      return json::parse(read_file(p));
+    } catch (const json::exception& e) {
+      throw InputError(p.string() + ": not JSON (" + std::string(e.what()).substr(0, 120) + ")");
+    }
+  };
+  if (!fs::exists(dir / "summary.json"))
+    throw InputError(dir.string() + ": summary.json missing (run not finished); render needs its geometry");
+  const fs::path summary_file = dir / "summary.json", frames_file = dir / "frames.json";
+  const json summary = parse(summary_file);
+  if (!summary.is_object() || !summary.contains("geometry") || !summary["geometry"].is_object())
+    throw InputError(summary_file.string() + ": not the summary of a nipdem run (no \"geometry\" object)");
+  const json geometry = summary["geometry"];
+  const json frames = fs::exists(frames_file) ? parse(frames_file) : json::array();
+  if (!frames.is_array()) throw InputError(frames_file.string() + ": not a frame list of a nipdem run (not an array)");
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const json& f = frames[k];
+    if (!f.is_array() || f.size() != 2 || !f[0].is_number() || !f[1].is_string())
+      throw InputError(fmt::format("{}: entry {} is not a frame [time_s, \"file.vtp\"]", frames_file.string(), k));
+  }
   if (frames.empty()) throw InputError(dir.string() + ": no particle snapshots (was output.vtk = false?)");
   double cmax = opt.color_max;
   if (cmax <= 0) {
@@ -260,7 +291,11 @@ int render_run(const fs::path& dir, const RenderOptions& opt) {
   int n = 0;
   for (const auto& f : frames) {
     Frame fr = read_vtp(dir / f[1].get<std::string>());
-    render_frame(fr, geometry, opt, dir / "frames" / fmt::format("frame_{:06d}.png", n), cmax);
+    try {
+      render_frame(fr, geometry, opt, dir / "frames" / fmt::format("frame_{:06d}.png", n), cmax);
+    } catch (const json::exception& e) {  // a key missing or of another type in the geometry
+      throw InputError(summary_file.string() + ": its \"geometry\" is not a nipdem run's (" + std::string(e.what()).substr(0, 120) + ")");
+    }
     ++n;
   }
   if (fs::exists(dir / "coverage.csv")) write_coverage_png(dir / "coverage.csv", dir / "coverage.png");
@@ -317,6 +352,7 @@ fs::path write_movie(const fs::path& run_dir, int fps) {
   // ffmpeg is started without a shell (posix_spawnp with an argument vector), so a folder name
   // with spaces, quotes or $ reaches it unchanged.
   const fs::path frames = run_dir / "frames", movie = frames / "movie.mp4";
+  check_replaceable(movie);
   fs::path tmp = movie;
   tmp += ".tmp." + std::to_string(::getpid()) + ".mp4";
   const std::string pattern = (frames / "frame_%06d.png").string(), out = tmp.string(), rate = std::to_string(fps);
@@ -336,7 +372,12 @@ fs::path write_movie(const fs::path& run_dir, int fps) {
     fs::remove(tmp, ec);
     throw std::runtime_error("ffmpeg failed to assemble " + movie.string());
   }
-  fs::rename(tmp, movie);
+  std::error_code ec;
+  fs::rename(tmp, movie, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot replace " + movie.string() + " by the new movie");
+  }
   return movie;
 }
 
