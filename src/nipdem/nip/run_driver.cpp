@@ -93,6 +93,16 @@ json run_nip(const NipConfig& cfg, const fs::path& out, const RunOptions& opt_in
                   fmt::format("the checkpoint {} is at t = {:g} s{}: nothing left to run", ckpt.string(), tc,
                               cfg.end_time < tc - 0.5 * dt ? "" : " and the run's summary.json exists"),
                   fmt::format("> {:g} s (the checkpoint's time plus half a step)", tc + 0.5 * dt));
+    // A run writes timeseries.csv (and, with snapshots, frames.json) at t = 0, before its first
+    // checkpoint: without them a resume would start the files afresh, losing the rows before the
+    // checkpoint (and writing snapshots over the first ones). Refused, naming the file.
+    for (const char* name : {"timeseries.csv", "frames.json"}) {
+      if (std::string_view(name) == "frames.json" && !cfg.vtk) continue;
+      if (!fs::exists(out / name))
+        throw InputError(fmt::format("{}: missing: the run wrote it before its checkpoint (t = {:g} s); resuming without it "
+                                     "would lose what it held. Put it back, or start the run again without --resume",
+                                     (out / name).string(), run.sim().time()));
+    }
     if (fs::exists(out / "frames.json")) {
       const fs::path fj = out / "frames.json";
       try {
