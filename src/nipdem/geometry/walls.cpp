@@ -254,7 +254,10 @@ void set_pyramid_roughness(Wall& w, double height, double base, double spacing) 
   if (w.n_periods < 3) throw_input("wall '" + w.name + "'", "roughness", "", "period longer than a third of the circumference");
   const double scale = circumference / (w.n_periods * nominal);  // stretch to fit exactly
   const double L = spacing * scale, B = base * scale;
-  w.profile = {{0.0, 0.0}, {L, 0.0}, {L + 0.5 * B, height}, {L + B, 0.0}};
+  // spacing 0: pyramids side by side, no flat between them (one point fewer: the profile's arc
+  // length must increase)
+  if (L > 0.0) w.profile = {{0.0, 0.0}, {L, 0.0}, {L + 0.5 * B, height}, {L + B, 0.0}};
+  else w.profile = {{0.0, 0.0}, {0.5 * B, height}, {B, 0.0}};
   w.prepare();
 }
 

@@ -112,6 +112,9 @@ NipConfig read_nip_config(const std::string& text, const std::string& file, cons
     c.rough_height = r.number("height_m", 0.0, 1e-3);
     c.rough_base = r.number("base_m", 1e-7, 1e-2);
     c.rough_spacing = r.number("spacing_m", 0.0, 1e-2);
+    if (c.rough_spacing > 0.0 && c.rough_spacing < 1e-9)  // a flat of atomic size: use 0 (side by side)
+      throw_input(file, "geometry.roughness.spacing_m", fmt::format("{:g}", c.rough_spacing), "a flat shorter than 1 nm",
+                  "0 (pyramids side by side) or [1e-9, 0.01]");
     r.finish();
     s.finish();
   }

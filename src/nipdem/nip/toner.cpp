@@ -1,5 +1,6 @@
 #include "nipdem/nip/toner.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -63,6 +64,23 @@ std::vector<ClusterTemplate> parse_templates(const std::string& text, const std:
       ct.offsets.push_back({x, y});
       ct.radii.push_back(r);
     }
+    // A toner particle is a cluster of touching spheres (eq. 2.1.1): its members span a few
+    // member radii. Members far apart, or of radii many decades apart, would scale to discs of
+    // no size beside a particle of the sampled volume (a time step of 0 or inf), reported far
+    // from this file: refused here. The bounds leave room for any real cluster (the library's
+    // span at most 2 largest radii).
+    const double rmax = *std::max_element(ct.radii.begin(), ct.radii.end());
+    const double rmin = *std::min_element(ct.radii.begin(), ct.radii.end());
+    if (!(rmin >= 1e-3 * rmax))
+      throw_input(file, key + ".discs", fmt::format("radii {:g} .. {:g}", rmin, rmax), "member radii more than 1000x apart",
+                  "smallest radius >= 1e-3 x largest");
+    double span = 0.0;
+    for (std::size_t a = 0; a < ct.offsets.size(); ++a)
+      for (std::size_t b = a + 1; b < ct.offsets.size(); ++b)
+        span = std::max(span, std::hypot(ct.offsets[a].x - ct.offsets[b].x, ct.offsets[a].y - ct.offsets[b].y));
+    if (!(span <= 100.0 * rmax))
+      throw_input(file, key + ".discs", fmt::format("centres {:g} apart", span),
+                  "members too far apart for a cluster of touching spheres", fmt::format("centres within 100 x the largest radius ({:g})", 100.0 * rmax));
     out.push_back(std::move(ct));
   }
   return out;
