@@ -1,9 +1,13 @@
 // `nipdem ldc verify [--json]`: reruns the LDC verification problems of thesis §3.8-3.10.
 // `nipdem ldc solve SETUP.{json,toml} [--json]`: solves one disc configuration (see docs/ldc.md).
+#include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <fmt/format.h>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 
 #include "nipdem/core/error.hpp"
@@ -47,7 +51,35 @@ void run_verify(bool as_json) {
               f36.g2);
 }
 
-void run_solve(const std::string& path, bool as_json) {
+// Progress of `ldc solve` on stderr (CLI.md: long runs show progress): a line before the
+// factorisation of a large coarse grid (one opaque step: 100 s CPU, 3.4 GB at 2048 x 2048 cells),
+// then, once the solve has taken 2 s, one line every 5 s with the iteration and its changes.
+class SolveProgress {
+ public:
+  explicit SolveProgress(bool enabled) : enabled_(enabled), start_(clock::now()), last_(start_) {}
+  double elapsed_s() const { return std::chrono::duration<double>(clock::now() - start_).count(); }
+  void say(const std::string& line) {
+    if (enabled_) std::fprintf(stderr, "ldc solve: %s\n", line.c_str());
+  }
+  void iteration(const nipdem::ldc::SolveStats& st, int max_iterations) {
+    const auto now = clock::now();
+    if (!enabled_ || std::chrono::duration<double>(now - start_).count() < 2.0 ||
+        (printed_ && std::chrono::duration<double>(now - last_).count() < 5.0))
+      return;
+    printed_ = true;
+    last_ = now;
+    std::fprintf(stderr, "ldc solve: iteration %d of at most %d, change of the disc potentials %.3e V, %.1f s\n",
+                 st.iterations, max_iterations, st.potential_change.empty() ? 0.0 : st.potential_change.back(),
+                 elapsed_s());
+  }
+
+ private:
+  using clock = std::chrono::steady_clock;
+  bool enabled_, printed_ = false;
+  clock::time_point start_, last_;
+};
+
+void run_solve(const std::string& path, bool as_json, bool quiet) {
   using namespace nipdem::ldc;
   const std::string text = nipdem::io::read_file(path);
   const bool is_toml = path.size() > 5 && path.compare(path.size() - 5, 5, ".toml") == 0;
@@ -62,8 +94,42 @@ void run_solve(const std::string& path, bool as_json) {
       throw nipdem::InputError(path + ": " + e.what());
     }
   };
+  SolveProgress progress(!quiet);
+  const double nodes = double(p.cells_x + 1) * double(p.cells_y + 1);
+  const bool large = nodes > 2.5e5;
+  named([&] { validate(p); });  // before saying anything about the grid
+  if (large)
+    progress.say(fmt::format("factorising the coarse matrix of {} x {} cells ({:.2g} nodes; at 2048 x 2048 cells this "
+                             "takes about 100 s of CPU and 3.4 GB)...", p.cells_x, p.cells_y, nodes));
   auto solver = named([&] { return std::make_unique<LdcSolver>(p); });
+  if (large) progress.say(fmt::format("factorised in {:.1f} s", progress.elapsed_s()));
+  solver->set_progress([&](const SolveStats& st) { progress.iteration(st, p.max_iterations); });
   const SolveStats& st = named([&]() -> const SolveStats& { return solver->solve(discs); });
+  if (!st.converged) {
+    // Not a result: the potentials and forces of an unfinished (or diverging) iteration. A failure
+    // of the solver on this geometry, not an invalid value (exit 1), so nothing goes to stdout.
+    const auto& pc = st.potential_change;
+    const double last = pc.empty() ? 0.0 : pc.back(), first = pc.empty() ? 0.0 : pc.front();
+    const bool diverged = !(last < first) && pc.size() > 1;
+    throw std::runtime_error(fmt::format(
+        "{}: the LDC iteration did not converge within max_iterations = {} (change of the disc potentials in the "
+        "last iteration {:.3g} V, in the first {:.3g} V; stop test: below tolerance = {:g} times the largest "
+        "potential){}; no result printed",
+        path, p.max_iterations, last, first, p.tolerance,
+        diverged ? ": it diverges for this geometry (seen for a large disc whose local domain is cut by the box "
+                   "sides, e.g. radius 0.4 mm in a 1 mm box, whatever the grid)"
+                 : ": raise max_iterations or tolerance"));
+  }
+  // Within validate()'s ranges every result is finite; should one not be, it is refused naming the
+  // values it was computed from rather than printed as null.
+  for (int k = 0; k < solver->disc_count(); ++k) {
+    const auto f = solver->force(k);
+    if (!std::isfinite(solver->potential(k)) || !std::isfinite(f.x) || !std::isfinite(f.y))
+      nipdem::throw_input(path, fmt::format("discs[{}]", k),
+                          fmt::format("potential {} V, force ({}, {}) N/m", solver->potential(k), f.x, f.y),
+                          "result not finite: check the scales permittivity_F_per_m, boundary.*.value_V, "
+                          "discs[].radius_m and discs[].charge_C_per_m");
+  }
   json out;
   out["iterations"] = st.iterations;
   out["converged"] = st.converged;
@@ -94,10 +160,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
   ver->callback([vjson] { run_verify(*vjson); });
 
   auto* sol = ldc->add_subcommand("solve", "Solve one disc configuration given in a JSON or TOML setup file");
-  struct Opts { std::string path; bool json = false; };
+  struct Opts { std::string path; bool json = false, quiet = false; };
   auto opts = std::make_shared<Opts>();
   sol->add_option("setup", opts->path, "setup file (.json or .toml, see docs/ldc.md)")->required();
   sol->add_flag("--json", opts->json, "print one JSON object");
-  sol->callback([opts] { run_solve(opts->path, opts->json); });
+  sol->add_flag("--quiet", opts->quiet, "no progress on stderr");
+  sol->callback([opts] { run_solve(opts->path, opts->json, opts->quiet); });
 });
 }  // namespace

@@ -68,6 +68,7 @@ struct LdcSolver::Impl {
   std::vector<double> source_prev, g_prev;
   int last_extrapolation = 0;
   bool aitken_off = false;
+  std::function<void(const SolveStats&)> progress;
 };
 
 // Aitken extrapolation of the LDC state (defect d and potentials g, which determine the next
@@ -357,6 +358,7 @@ void LdcSolver::Impl::run() {
     for (double v : u) scale = std::max(scale, std::abs(v));
     stats.potential_change.push_back(dg);
     stats.iterations = it;
+    if (progress) progress(stats);
     const double tol = p.tolerance * std::max(scale, 1e-300);
     if (it > 1 && dg <= tol && delta <= tol) {
       stats.converged = true;
@@ -393,6 +395,7 @@ const SolveStats& LdcSolver::solve(std::span<const Disc> discs) {
 }
 
 void LdcSolver::reset_warm_start() { impl_->have_warm = false; }
+void LdcSolver::set_progress(std::function<void(const SolveStats&)> progress) { impl_->progress = std::move(progress); }
 int LdcSolver::disc_count() const { return int(impl_->discs.size()); }
 double LdcSolver::potential(int k) const { return impl_->g.at(k); }
 Vec2 LdcSolver::force(int k) const { return impl_->forces.at(k); }

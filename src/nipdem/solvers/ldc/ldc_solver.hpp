@@ -15,6 +15,7 @@
 // coupling LDC into the time loop would be its own piece of work (docs/ldc.md). Consecutive solve() calls with the same number of
 // discs warm-start from the previous potentials, coarse solution and defect.
 #pragma once
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -50,6 +51,9 @@ class LdcSolver {
   // discs equals that of the previous call.
   const SolveStats& solve(std::span<const Disc> discs);
   void reset_warm_start();
+  // Called after every LDC iteration of solve() with the statistics so far (iterations,
+  // potential_change, delta), e.g. for a progress line; empty (the default) calls nothing.
+  void set_progress(std::function<void(const SolveStats&)> progress);
 
   int disc_count() const;
   double potential(int k) const;         // g_k [V]

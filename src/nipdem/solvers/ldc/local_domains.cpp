@@ -4,6 +4,10 @@
 #include <cmath>
 #include <numeric>
 
+#include <fmt/format.h>
+
+#include "nipdem/core/error.hpp"
+
 #include "nipdem/solvers/ldc/schwarz.hpp"
 
 namespace nipdem::ldc {
@@ -33,6 +37,46 @@ double rect_distance(Vec2 lo, Vec2 hi, Vec2 c) {
   const double dx = std::max({lo.x - c.x, 0.0, c.x - hi.x});
   const double dy = std::max({lo.y - c.y, 0.0, c.y - hi.y});
   return std::hypot(dx, dy);
+}
+// A disc of a finite-difference group with no fine node inside it (the fine grid is capped at
+// kMaxFineNodes) would give the local matrix a zero column for its potential: the LU fails
+// ("singular") after seconds of work. That happens when a disc much smaller than a coarse cell sits
+// within about a coarse cell of the box side or of another disc (e.g. a 5 um disc 0.5 mm from the
+// side of the default 1 m box with 20 cells). Refused here, naming the disc, with the radius that
+// a fine cell of this grid needs (half its diagonal: a circle that large always holds a node).
+void check_fd_resolution(const CoarseGrid& grid, std::span<const Disc> discs, const std::vector<LocalGroup>& groups) {
+  for (const LocalGroup& g : groups) {
+    if (g.method != LocalMethod::finite_difference) continue;
+    // The fine grid exactly as FdLocalProblem lays it out (local_fd.cpp: node(), assemble()).
+    const Vec2 lo = grid.node(g.i0, g.j0);
+    const double hx = grid.hx() / g.refinement, hy = grid.hy() / g.refinement, hmin = std::min(hx, hy);
+    const int nx = (g.i1 - g.i0) * g.refinement + 1, ny = (g.j1 - g.j0) * g.refinement + 1;
+    const bool neu[4] = {g.i0 == 0 && grid.neumann_x_min(), g.i1 == grid.nx() - 1 && grid.neumann_x_max(),
+                         g.j0 == 0 && grid.neumann_y_min(), g.j1 == grid.ny() - 1 && grid.neumann_y_max()};
+    for (int k : g.members) {
+      const Disc& d = discs[k];
+      const double fi = (d.center_m.x - lo.x) / hx, fj = (d.center_m.y - lo.y) / hy;
+      bool has_node = false;
+      for (double ci : {std::floor(fi), std::ceil(fi)})
+        for (double cj : {std::floor(fj), std::ceil(fj)}) {
+          if (ci < 0 || cj < 0 || ci > nx - 1 || cj > ny - 1) continue;
+          if ((ci == 0 && !neu[0]) || (ci == nx - 1 && !neu[1]) || (cj == 0 && !neu[2]) || (cj == ny - 1 && !neu[3]))
+            continue;  // a Dirichlet side node, never a conductor node
+          const Vec2 x{lo.x + int(ci) * hx, lo.y + int(cj) * hy};
+          has_node = has_node || norm(x - d.center_m) <= d.radius_m + 1e-3 * hmin;
+        }
+      if (has_node) continue;
+      const double needed = 0.5 * std::hypot(hx, hy);
+      throw_input("ldc", fmt::format("discs[{}].radius_m", k), fmt::format("{:g}", d.radius_m),
+                  fmt::format("disc too small for the coarse grid: it is within about one coarse cell (H = {:g} m) of "
+                              "the box side or another disc, so it needs a finite-difference local problem, whose fine "
+                              "grid (at most {:g} nodes) has cells of {:g} x {:g} m and no node inside the disc",
+                              std::max(grid.hx(), grid.hy()), kMaxFineNodes, hx, hy),
+                  fmt::format("radius_m >= {:g} m with this box and box.cells_x/cells_y, or more cells or a smaller box "
+                              "(the default box is 1 m x 1 m with 20 x 20 cells)",
+                              needed));
+    }
+  }
 }
 }  // namespace
 
@@ -155,6 +199,7 @@ std::vector<LocalGroup> build_local_groups(const CoarseGrid& grid, std::span<con
     }
     if (!merged) break;
   }
+  check_fd_resolution(grid, discs, groups);
   return groups;
 }
 

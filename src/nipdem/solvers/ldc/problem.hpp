@@ -83,6 +83,17 @@ struct Params {
   double hy() const { return (y_max_m - y_min_m) / cells_y; }
 };
 
+// Ranges of the problem's scales checked by validate() / validate_discs(). SI units, but wide
+// enough for dimensionless problems (ε = 1, unit box, q ~ 1: the verification problems). Inside
+// them every potential, field and force of a solve is far from overflow or underflow.
+inline constexpr double kMaxCoordinate_m = 1e3;      // |box corner|
+inline constexpr double kMinBox_m = 1e-9;            // box width and height
+inline constexpr double kMinPermittivity = 1e-12;    // F/m (vacuum: 8.854e-12)
+inline constexpr double kMaxPermittivity = 1e3;      // F/m
+inline constexpr double kMaxPotential_V = 1e9;       // |Dirichlet side value|
+inline constexpr double kMaxCharge_C_per_m = 1e3;    // |disc charge per unit length|
+inline constexpr double kMinRadius_m = 1e-9;         // disc radius
+
 // Throws InputError naming the key for an invalid grid/box/parameter.
 void validate(const Params& p);
 // Throws InputError for discs outside the box, overlapping discs, non-positive radius or
