@@ -68,15 +68,16 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--freq", o->freq, "frequencies F1:F2:STEP [Hz]")->required();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
-    // Physical ranges (the thesis' circuit: R ~ 1e6, Rd >= 1e24 ohm, C ~ 1e-12 F, Rm = 1e4 ohm,
-    // 40 V, 500-2000 Hz) with wide margins, so that no amplitude or phase overflows into null.
-    // Checked before ProbeCircuitParams::validate so that a message names the option.
+    // A value <= 0 is refused by validate (its message is the one Python's nipdem.rc_response
+    // gives, tests/python/test_functions.py); then physical ranges (the thesis' circuit: R ~ 1e6,
+    // Rd >= 1e24 ohm, C ~ 1e-12 F, Rm = 1e4 ohm, 40 V, 500-2000 Hz) with wide margins, so that no
+    // amplitude or phase overflows into null.
+    o->p.validate();
     nipdem::require_range("rc response", "--R", o->p.R_ohm, 1e-3, 1e30);
     nipdem::require_range("rc response", "--Rd", o->p.Rd_ohm, 1e-3, 1e40);
     nipdem::require_range("rc response", "--C", o->p.C_F, 1e-24, 1.0);
     nipdem::require_range("rc response", "--Rm", o->p.Rm_ohm, 1e-3, 1e30);
     check_amplitude("rc response", o->voltage);
-    o->p.validate();
     const auto fs = nipdem::probe::parse_frequency_range(o->freq);
     if (fs.back() > kMaxFrequency_Hz)
       nipdem::throw_input("rc response", "--freq", o->freq, fmt::format("frequencies above {:g} Hz", kMaxFrequency_Hz),

@@ -134,7 +134,6 @@ TEST(HostileRc, MessagesNameTheOptionGivenAndItsRange) {
       {kElectric + " --dielectric-layer --layer-permittivity 1e-300", {"'--layer-permittivity'", "[1, 100000]"}},
       {kElectric + " --dielectric-layer --layer-permittivity 0", {"'--layer-permittivity'"}},
       {kResponse + " --voltage 5 --Rm 1e308", {"'--Rm'", "[0.001, 1e+30]"}},
-      {"rc response --R -1 --Rd 1.8e24 --C 3.9e-16 --voltage 5 --freq 1:10:1 --json", {"'--R'", "[0.001, 1e+30]"}},
       {"rc response --R 5.9e11 --Rd 1.8e24 --C 3.9e-16 --voltage 5 --freq 1:1e300:1e299 --json", {"'--freq'", "1e+12 Hz"}},
       {"rc charge --json --pattern " + kLine + " --dt 1e-300", {"'--dt' = 1e-300", "output rows"}},
       {"rc charge --json --pattern " + kLine + " --C 0", {"'--C'", "[1e-24, 1]"}},
