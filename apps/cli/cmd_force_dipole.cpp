@@ -36,10 +36,31 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
     using namespace nipdem;
-    // Physical ranges (far beyond toner's: m ~ 4e-11 A m^2, d ~ 13 um), so no result overflows.
-    require_range("force dipole", "--moment", o->moment, -1e-3, 1e-3);
+    // Physical ranges (far beyond toner's: m ~ 4e-11 A m^2, d ~ 13 um), so no result overflows;
+    // checked here so that a message names the option (pigment_study names its fields).
+    if (!(o->moment > 0.0 && o->moment <= 1e-3))
+      throw_input("force dipole", "--moment", fmt::format("{:g}", o->moment),
+                  "out of range (the moment's size: its direction is --angle)", "(0, 0.001] A m^2");
     require_range("force dipole", "--distance", o->distance, 1e-9, 1.0);
     require_range("force dipole", "--radius", o->radius, 1e-9, 1e-2);
+    if (!(o->distance > 2.0 * o->radius))
+      throw_input("force dipole", "--distance", fmt::format("{:g}", o->distance),
+                  fmt::format("the spheres would overlap (--radius {:g})", o->radius), "> 2 x --radius");
+    require_range("force dipole", "--angle", o->angle_deg, -5e4, 5e4);
+    if (o->pigments < 1 || o->pigments > 1000000)
+      throw_input("force dipole", "--pigments", fmt::format("{}", o->pigments), "out of range", "[1, 1000000]");
+    // --samples is validated even with --pigments 1 (one placement; the JSON reports samples = 1).
+    if (o->samples < 1 || o->samples > 10000000)
+      throw_input("force dipole", "--samples", fmt::format("{}", o->samples), "out of range", "[1, 1e7]");
+    // The cost is pigments^2 x samples pair forces at ~1e8 per second (1000 pigments x 1000
+    // samples: 8 s), with no progress shown: more than kMaxPairs (~10 s) is refused.
+    constexpr double kMaxPairs = 1e9;
+    const double pairs = static_cast<double>(o->pigments) * o->pigments * (o->pigments == 1 ? 1 : o->samples);
+    if (pairs > kMaxPairs)
+      throw_input("force dipole", "--pigments, --samples", fmt::format("{}, {}", o->pigments, o->samples),
+                  fmt::format("{:g} pigment-pair forces (pigments^2 x samples) would take about {:.0f} s at ~1e8 per second", pairs,
+                              pairs / 1e8),
+                  fmt::format("pigments^2 x samples <= {:g} (about 10 s)", kMaxPairs));
     dipole::PigmentStudyParams p;
     p.moment_Am2 = o->moment;
     p.distance_m = o->distance;

@@ -32,27 +32,46 @@ nipdem::cli::Register reg([](CLI::App& app) {
       ->required();
   sub->add_option("--model", o->model, "exact (capacitance series) | series (thesis eq. 2.5.31, corrected) | approx (eq. 2.5.42)")
       ->capture_default_str();
-  sub->add_option("--approx-coefficient", o->approx_coefficient, "coefficient a of eq. 2.5.42 [-]")->capture_default_str();
+  auto* coef_opt = sub->add_option("--approx-coefficient", o->approx_coefficient, "coefficient a of eq. 2.5.42 [-] (only with --model approx)")
+                       ->capture_default_str();
   sub->add_flag("--dielectric-layer", o->layer,
                 "treat --gap as the distance l to the coated drum surface and use d = l + d_l/eps_r (eq. 2.5.43)");
-  sub->add_option("--layer-thickness", o->layer_thickness, "SiOx layer thickness d_l [m]")->capture_default_str();
-  sub->add_option("--layer-permittivity", o->layer_eps, "SiOx relative permittivity eps_r [-]")->capture_default_str();
+  auto* thick_opt = sub->add_option("--layer-thickness", o->layer_thickness, "SiOx layer thickness d_l [m] (only with --dielectric-layer)")
+                        ->capture_default_str();
+  auto* eps_opt = sub->add_option("--layer-permittivity", o->layer_eps, "SiOx relative permittivity eps_r [-] (only with --dielectric-layer)")
+                      ->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
-  sub->callback([o] {
+  sub->callback([o, coef_opt, thick_opt, eps_opt] {
     using namespace nipdem::electric;
     ElectricForceParams p;
     p.model = parse_force_model(o->model, "force electric", "--model");
-    p.approx_coefficient = o->approx_coefficient;
-    p.validate();
-    // Physical ranges (far beyond toner's), so that no result overflows into null (issue 21).
+    // An option that would have no effect is refused rather than silently ignored.
+    if (coef_opt->count() > 0 && p.model != ForceModel::approx)
+      nipdem::throw_input("force electric", "--approx-coefficient", fmt::format("{:g}", o->approx_coefficient),
+                          fmt::format("has no effect with --model {}", to_string(p.model)), "--approx-coefficient with --model approx");
+    for (const auto* opt : {thick_opt, eps_opt})
+      if (opt->count() > 0 && !o->layer)
+        nipdem::throw_input("force electric", opt->get_name(), opt->as<std::string>(), "has no effect without --dielectric-layer",
+                            opt->get_name() + " together with --dielectric-layer");
+    // Physical ranges (far beyond toner's: R ~ 5 um, l ~ 1 um, 40 V, a = 0.45, SiOx 600 nm with
+    // eps_r = 5), so that no result overflows into null (issue 21); named by option.
     nipdem::require_range("force electric", "--radius", o->radius, 1e-9, 1e-2);
     nipdem::require_range("force electric", "--gap", o->gap, 1e-12, 1.0);
     nipdem::require_range("force electric", "--voltage", o->voltage, -1e6, 1e6);
+    nipdem::require_range("force electric", "--approx-coefficient", o->approx_coefficient, 1e-3, 100.0);
+    if (o->layer) {
+      nipdem::require_range("force electric", "--layer-thickness", o->layer_thickness, 0.0, 1e-2);
+      nipdem::require_range("force electric", "--layer-permittivity", o->layer_eps, 1.0, 1e5);
+    }
+    p.approx_coefficient = o->approx_coefficient;
+    p.validate();
     const double d = o->layer ? effective_gap(o->gap, o->layer_thickness, o->layer_eps) : o->gap;
     const double F = force(p, o->radius, o->voltage, d);
     const double Fexact = force_exact(o->radius, o->voltage, d);
-    if (!std::isfinite(F) || !std::isfinite(Fexact))
-      nipdem::throw_input("force electric", "--radius, --gap, --voltage", fmt::format("{:g} m, {:g} m, {:g} V", o->radius, o->gap, o->voltage),
+    if (!std::isfinite(F) || !std::isfinite(Fexact))  // not reached within the ranges above
+      nipdem::throw_input("force electric", "--radius, --gap, --voltage, --approx-coefficient, --layer-thickness, --layer-permittivity",
+                          fmt::format("{:g} m, {:g} m, {:g} V, {:g}, {:g} m, {:g}", o->radius, o->gap, o->voltage,
+                                      o->approx_coefficient, o->layer_thickness, o->layer_eps),
                           "the force is not representable for these inputs");
     if (o->json) {
       nlohmann::json j;

@@ -17,6 +17,24 @@ namespace {
 
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
+// Highest frequency of `rc response --freq` and of a `calibrate rc` data row (the probe is
+// measured at 500-2000 Hz; within these bounds no term of eq. 4.7.7 overflows).
+constexpr double kMaxFrequency_Hz = nipdem::probe::kMaxFrequency_Hz;
+
+// --voltage of rc response and calibrate rc: the amplitude V of the applied V sin(wt), so
+// positive. A negative V would be the same signal shifted by 180 deg; the phase is given
+// relative to the applied signal, so it would print exactly the results of |V|: refused
+// rather than silently treated as |V|.
+void check_amplitude(const std::string& where, double V) {
+  const std::string allowed = "[1e-06, 1e+06] V";
+  if (V < 0.0)
+    nipdem::throw_input(where, "--voltage", fmt::format("{:g}", V),
+                        "is the amplitude of the applied V sin(wt) and must be positive (a negative amplitude is the "
+                        "same signal shifted by 180 deg; give its magnitude)",
+                        allowed);
+  if (!(V >= 1e-6 && V <= 1e6)) nipdem::throw_input(where, "--voltage", fmt::format("{:g}", V), "out of range", allowed);
+}
+
 struct ResponseOpts {
   nipdem::probe::ProbeCircuitParams p;
   double voltage = 40.0;
@@ -50,20 +68,27 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--freq", o->freq, "frequencies F1:F2:STEP [Hz]")->required();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
+    // A value <= 0 is refused by validate (its message is the one Python's nipdem.rc_response
+    // gives, tests/python/test_functions.py); then physical ranges (the thesis' circuit: R ~ 1e6,
+    // Rd >= 1e24 ohm, C ~ 1e-12 F, Rm = 1e4 ohm, 40 V, 500-2000 Hz) with wide margins, so that no
+    // amplitude or phase overflows into null.
     o->p.validate();
-    // Physical ranges (the thesis' circuit: R ~ 1e6, Rd >= 1e24 ohm, C ~ 1e-12 F) with wide
-    // margins, so that no amplitude or phase overflows into null.
     nipdem::require_range("rc response", "--R", o->p.R_ohm, 1e-3, 1e30);
     nipdem::require_range("rc response", "--Rd", o->p.Rd_ohm, 1e-3, 1e40);
     nipdem::require_range("rc response", "--C", o->p.C_F, 1e-24, 1.0);
-    nipdem::require_range("rc response", "--voltage", o->voltage, -1e6, 1e6);
+    nipdem::require_range("rc response", "--Rm", o->p.Rm_ohm, 1e-3, 1e30);
+    check_amplitude("rc response", o->voltage);
     const auto fs = nipdem::probe::parse_frequency_range(o->freq);
+    if (fs.back() > kMaxFrequency_Hz)
+      nipdem::throw_input("rc response", "--freq", o->freq, fmt::format("frequencies above {:g} Hz", kMaxFrequency_Hz),
+                          fmt::format("F1:F2:STEP with 0 < F1 <= F2 <= {:g} Hz", kMaxFrequency_Hz));
     nlohmann::json rows = nlohmann::json::array();
     if (!o->json) std::printf("%14s %16s %12s\n", "frequency_Hz", "amplitude_V", "phase_deg");
     for (double f : fs) {
       const auto r = nipdem::probe::response(o->p, o->voltage, f);
-      if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))
-        nipdem::throw_input("rc response", "--R, --Rd, --C, --voltage", fmt::format("at {:g} Hz", f), "the response is not computable for these inputs");
+      if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))  // not reached within the ranges above
+        nipdem::throw_input("rc response", "--R, --Rd, --C, --Rm, --voltage, --freq", fmt::format("at {:g} Hz", f),
+                            "the response is not computable for these inputs");
       if (o->json) {
         rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
       } else {
@@ -87,30 +112,46 @@ nipdem::cli::Register reg([](CLI::App& app) {
   auto q = std::make_shared<ChargeOpts>();
   ch->add_option("--pattern", q->pattern, "TOML file with a [print] table (see docs/charge-model.md)")->required();
   ch->add_option("--R", q->R, "path resistance [ohm]")->capture_default_str();
-  ch->add_option("--Rd", q->Rd, "toner-drum leak resistance when touching [ohm]")->capture_default_str();
+  auto* rd_opt = ch->add_option("--Rd", q->Rd, "toner-drum leak resistance when touching [ohm] (only with --contact)")
+                     ->capture_default_str();
   ch->add_option("--C", q->C, "toner-drum capacity [F]")->capture_default_str();
   ch->add_option("--drum-speed", q->drum_speed, "drum surface speed [m/s] (CPS700: 6.7 m/min)")->capture_default_str();
   ch->add_option("--dt", q->dt, "output interval [s]")->capture_default_str();
-  ch->add_option("--t-end", q->t_end, "end time [s] (default: 1.2 x the end of the last line)");
+  auto* t_end_opt = ch->add_option("--t-end", q->t_end, "end time [s] (default: 1.2 x the end of the last line)");
   ch->add_flag("--contact", q->contact, "particle touches the drum (leak through Rd)");
   ch->add_flag("--json", q->json, "print one JSON object on stdout");
-  ch->callback([q] {
+  ch->callback([q, t_end_opt, rd_opt] {
     using namespace nipdem;
     const io::PrintPattern pat = io::load_print_pattern(q->pattern);
-    require_positive("rc charge", "--drum-speed", q->drum_speed);
+    // Ranges far beyond the thesis' (R ~ 6e11, Rd ~ 1.8e24 ohm, C ~ 4e-16 F, 6.7 m/min), the same
+    // as rc response's, so that tau = R C and the voltages stay finite; named by option.
+    require_range("rc charge", "--R", q->R, 1e-3, 1e30);
+    require_range("rc charge", "--C", q->C, 1e-24, 1.0);
+    if (rd_opt->count() > 0 && !q->contact)
+      throw_input("rc charge", "--Rd", fmt::format("{:g}", q->Rd),
+                  "has no effect without --contact (the leak through Rd exists only while the particle touches the drum)",
+                  "--Rd together with --contact");
+    require_range("rc charge", "--Rd", q->Rd, 1e-3, 1e40);
+    require_range("rc charge", "--drum-speed", q->drum_speed, 1e-6, 100.0);
     require_positive("rc charge", "--dt", q->dt);
+    const bool t_end_given = t_end_opt->count() > 0;
+    if (t_end_given) require_positive("rc charge", "--t-end", q->t_end);  // 0 or less is not "the default"
     charge::RcChargeParams p;
     p.C_td_F = q->C;
     p.R_td_ohm = q->Rd;
     p.validate();
-    require_positive("rc charge", "--R", q->R);
     double t_end = q->t_end;
-    if (t_end <= 0.0) {
+    if (!t_end_given) {
       const double s_end = pat.segments().empty() ? 0.0 : pat.segments().back().end_m;
       t_end = 1.2 * std::max(s_end, 0.0) / q->drum_speed;
       if (t_end <= 0.0) t_end = 10 * q->R * q->C;
     }
-    if (t_end / q->dt > 1e6) throw_input("rc charge", "--dt", std::to_string(q->dt), "more than 1e6 output rows", ">= t_end/1e6");
+    if (t_end / q->dt > 1e6)
+      throw_input("rc charge", t_end_given ? "--dt, --t-end" : "--dt",
+                  t_end_given ? fmt::format("{:g} s, {:g} s", q->dt, t_end) : fmt::format("{:g}", q->dt),
+                  fmt::format("{:g} output rows up to t_end = {:g} s ({}), more than 1e6", t_end / q->dt, t_end,
+                              t_end_given ? "--t-end" : "the default end: 1.2 x the end of the last line / --drum-speed"),
+                  fmt::format(">= t_end/1e6 = {:g} s, or a shorter --t-end", t_end / 1e6));
     const auto coupling = q->contact ? charge::DrumCoupling::contact : charge::DrumCoupling::capacitor;
     nlohmann::json rows = nlohmann::json::array();
     double u = 0.0, t = 0.0;
@@ -123,7 +164,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
       const double t_next = (k + 1) * q->dt;
       while (t < t_next) {
         const double s_sw = pat.next_switch_after(q->drum_speed * t) / q->drum_speed;
-        const double t_stop = std::min(t_next, s_sw);
+        double t_stop = std::min(t_next, s_sw);
+        // A switch point s/v can round to a time whose drum position v t lies just before s: the
+        // same switch would be found again without progress (a hang, e.g. --drum-speed 1e300).
+        // Step one ulp past it instead; never reached when the division lands on or after s.
+        if (!(t_stop > t)) t_stop = std::nextafter(t, t_next);
         u = charge::rc_update(u, pat.voltage_at_time(t, q->drum_speed), q->R, coupling, p, t_stop - t);
         t = t_stop;
       }
@@ -151,8 +196,35 @@ nipdem::cli::Register reg([](CLI::App& app) {
   csub->add_option("--phase-std-deg", c->fit.phase_std_deg, "known phase noise [deg] (0: estimate)")->capture_default_str();
   csub->add_flag("--json", c->json, "print one JSON object on stdout");
   csub->callback([c] {
+    using nipdem::require_range;
+    // Options by name before RcFitOptions::validate (which names the fields): the thesis' set-up
+    // is 40 V, Rm = 10 kOhm, ~1e5 particles on the probe; the ranges leave wide margins.
+    check_amplitude("calibrate rc", c->fit.voltage_V);
+    require_range("calibrate rc", "--Rm", c->fit.Rm_ohm, 1e-3, 1e30);
+    require_range("calibrate rc", "--particles", c->fit.particles, 1.0, 1e12);
+    require_range("calibrate rc", "--amplitude-rel-std", c->fit.amplitude_rel_std, 0.0, 10.0);
+    require_range("calibrate rc", "--phase-std-deg", c->fit.phase_std_deg, 0.0, 90.0);
     const auto data = nipdem::probe::read_rc_csv(c->data);
+    // The circuit is a passive divider: one particle's amplitude is below the applied one.
+    for (std::size_t i = 0; i < data.size(); ++i)
+      if (!(data[i].amplitude_V < c->fit.particles * c->fit.voltage_V))
+        nipdem::throw_input(c->data, fmt::format("data row {} ({:g} Hz) column amplitude_V", i + 1, data[i].frequency_Hz),
+                            fmt::format("{:g}", data[i].amplitude_V),
+                            fmt::format("not below --particles x --voltage = {:g} x {:g} V, which the circuit cannot produce",
+                                        c->fit.particles, c->fit.voltage_V),
+                            "(0, particles x voltage)");
     const auto r = nipdem::probe::fit_rc(data, c->fit);
+    // A fit that ran into the search box or whose chi2/uncertainties are not finite has no
+    // meaning (fit_rc then reports converged = false): the data do not fit the circuit for
+    // these options.
+    if (!r.limit_hit.empty() || !std::isfinite(r.chi2) || !std::isfinite(r.R_log_std) || !std::isfinite(r.C_log_std))
+      nipdem::throw_input(c->data, "--particles, --voltage, --Rm",
+                          fmt::format("{:g}, {:g} V, {:g} ohm", c->fit.particles, c->fit.voltage_V, c->fit.Rm_ohm),
+                          fmt::format("the data cannot be fitted by the probe circuit ({})",
+                                      r.limit_hit.empty() ? fmt::format("chi2 = {:g}, sd(ln R) = {:g}, sd(ln C) = {:g}", r.chi2,
+                                                                        r.R_log_std, r.C_log_std)
+                                                          : r.limit_hit),
+                          "data whose amplitudes / --particles fit the circuit driven by --voltage with --Rm");
     if (c->json) {
       nlohmann::json j;
       j["R_ohm"] = r.R_ohm;

@@ -219,7 +219,9 @@ std::vector<RcDataPoint> parse_rc_csv(const std::string& text, const std::string
         throw_input(source, fmt::format("line {} column {}", lineno, names[j]), s, "not a finite number");
       }
     }
-    if (!(v[0] > 0)) throw_input(source, fmt::format("line {} column frequency_Hz", lineno), f[ci[0]], "must be positive", "(0, inf)");
+    if (!(v[0] > 0 && v[0] <= kMaxFrequency_Hz))
+      throw_input(source, fmt::format("line {} column frequency_Hz", lineno), f[ci[0]], "out of range",
+                  fmt::format("(0, {:g}] Hz", kMaxFrequency_Hz));
     if (!(v[1] > 0)) throw_input(source, fmt::format("line {} column amplitude_V", lineno), f[ci[1]], "must be positive", "(0, inf)");
     if (!(std::fabs(v[2]) < 90.0))
       throw_input(source, fmt::format("line {} column phase_deg", lineno), f[ci[2]], "out of range", "(-90, 90)");
@@ -240,6 +242,7 @@ RcFitResult fit_rc(const std::vector<RcDataPoint>& data, const RcFitOptions& opt
   if (data.size() < 3) throw_input("calibrate rc", "data", std::to_string(data.size()) + " rows", "too few", ">= 3");
   for (const auto& d : data) {
     require_positive("calibrate rc", "frequency_Hz", d.frequency_Hz);
+    require_range("calibrate rc", "frequency_Hz", d.frequency_Hz, 0.0, kMaxFrequency_Hz);
     require_positive("calibrate rc", "amplitude_V", d.amplitude_V);
     require_range("calibrate rc", "phase_deg", d.phase_deg, -90.0, 90.0);
   }
@@ -297,6 +300,15 @@ RcFitResult fit_rc(const std::vector<RcDataPoint>& data, const RcFitOptions& opt
   res.R_ohm_std = res.R_ohm * res.R_log_std;
   res.C_F_std = res.C_F * res.C_log_std;
   res.Rd_ohm_std = res.Rd_identifiable ? res.Rd_ohm * res.Rd_log_std : kInf;
+
+  // A fit stuck at the search box or without finite chi2 / uncertainties is no fit.
+  const double tol = 1e-6;  // in ln units
+  if (x[0] <= kLo[0] + tol || x[0] >= kHi[0] - tol)
+    res.limit_hit = fmt::format("R_ohm = {:g} is at the end of the search range [1, 1e30] ohm", res.R_ohm);
+  else if (x[2] <= kLo[2] + tol || x[2] >= kHi[2] - tol)
+    res.limit_hit = fmt::format("C_F = {:g} is at the end of the search range [1e-30, 1] F", res.C_F);
+  if (!res.limit_hit.empty() || !std::isfinite(res.chi2) || !std::isfinite(res.R_log_std) || !std::isfinite(res.C_log_std))
+    res.converged = false;
   return res;
 }
 

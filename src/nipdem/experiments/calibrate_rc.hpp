@@ -22,6 +22,10 @@
 
 namespace nipdem::probe {
 
+// Highest frequency accepted (data rows, `rc response --freq`): the probe is measured at
+// 500-2000 Hz; below this bound no term of eq. 4.7.7 overflows for any circuit in the search box.
+inline constexpr double kMaxFrequency_Hz = 1e12;
+
 struct RcDataPoint {
   double frequency_Hz = 0.0;
   double amplitude_V = 0.0;
@@ -30,7 +34,7 @@ struct RcDataPoint {
 
 // Reads a CSV with a header naming the columns frequency_Hz, amplitude_V, phase_deg (any
 // order; extra columns ignored; '#' comment lines and blank lines skipped). Throws InputError
-// naming the file, line and column for a missing column, a non-number, f <= 0, amplitude <= 0,
+// naming the file, line and column for a missing column, a non-number, f <= 0 or f > kMaxFrequency_Hz, amplitude <= 0,
 // |phase| >= 90 deg, or fewer than 3 rows.
 std::vector<RcDataPoint> read_rc_csv(const std::filesystem::path& path);
 std::vector<RcDataPoint> parse_rc_csv(const std::string& text, const std::string& source);
@@ -57,8 +61,11 @@ struct RcFitResult {
   double chi2 = 0;                // weighted, at the optimum
   int dof = 0;
   int iterations = 0;
-  bool converged = false;
+  bool converged = false;         // false also when chi2 or sd(ln R), sd(ln C) is not finite or limit_hit is set
   double tau_s = 0;               // (R + Rm) C, the RC time of the circuit
+  // Non-empty when R or C ended at the search box (R in [1, 1e30] ohm, C in [1e-30, 1] F): then
+  // the values are the box, not a fit (e.g. amplitudes scaled by a wrong particle count); says which.
+  std::string limit_hit;
 };
 
 RcFitResult fit_rc(const std::vector<RcDataPoint>& data, const RcFitOptions& opt = {});
