@@ -81,10 +81,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
   exp->add_option("--preset", eo->preset, "magnet preset: black or color")->capture_default_str();
   exp->add_option("--x0", eo->x0, "first x [m]")->capture_default_str();
   exp->add_option("--x1", eo->x1, "last x [m]")->capture_default_str();
-  exp->add_option("--nx", eo->nx, "nodes along x (>= 5)")->capture_default_str();
+  // Ranges checked on the text, as for `field line --n` below.
+  exp->add_option("--nx", eo->nx, "nodes along x, in [5, 1e5]")->capture_default_str()->check(CLI::Range(5, 100000).description(""));
   exp->add_option("--y0", eo->y0, "first y [m]")->capture_default_str();
   exp->add_option("--y1", eo->y1, "last y [m]")->capture_default_str();
-  exp->add_option("--ny", eo->ny, "nodes along y (>= 5)")->capture_default_str();
+  exp->add_option("--ny", eo->ny, "nodes along y, in [5, 1e5]")->capture_default_str()->check(CLI::Range(5, 100000).description(""));
   exp->add_option("--out", eo->out, "output CSV file (written atomically)")->required();
   exp->callback([eo] {
     require_range("field export", "--nx", eo->nx, 5, 1e5);
@@ -110,7 +111,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
   line->add_option("--y", lo->y, "height above the roller surface [m]")->capture_default_str();
   line->add_option("--x0", lo->x0, "first x [m]")->capture_default_str();
   line->add_option("--x1", lo->x1, "last x [m]")->capture_default_str();
-  line->add_option("--n", lo->n, "number of points")->capture_default_str();
+  // The range is checked on the text (a value beyond int was "Could not convert", without the
+  // range); no description, so that the type stays INT for main.cpp's plain-integer check.
+  line->add_option("--n", lo->n, "number of points, in [2, 1e6]")->capture_default_str()->check(CLI::Range(2, 1000000).description(""));
   line->add_option("--out", lo->out, "output CSV file (written atomically)")->required();
   line->callback([lo] {
     require_range("field line", "--n", lo->n, 2, 1e6);
