@@ -1,5 +1,6 @@
 // `nipdem field probe|line`: the magnet field (analytic preset or imported map), its gradient and
 // the magnet force on a toner particle (thesis §2.4.2 eq. 2.4.34, §4.5 eq. 4.5.1; fig. 2.12 analogue).
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
@@ -114,13 +115,22 @@ nipdem::cli::Register reg([](CLI::App& app) {
   // The range is checked on the text (a value beyond int was "Could not convert", without the
   // range); no description, so that the type stays INT for main.cpp's plain-integer check.
   line->add_option("--n", lo->n, "number of points, in [2, 1e6]")->capture_default_str()->check(CLI::Range(2, 1000000).description(""));
-  line->add_option("--out", lo->out, "output CSV file (written atomically)")->required();
+  line->add_option("--out", lo->out, "output CSV file (written atomically); its picture goes next to it, the name with .png (so not itself a .png)")->required();
   line->callback([lo] {
     require_range("field line", "--n", lo->n, 2, 1e6);
     require_range("field line", "--y", lo->y, -1.0, 1.0);
     require_range("field line", "--x0", lo->x0, -1.0, 1.0);
     require_range("field line", "--x1", lo->x1, -1.0, 1.0);
     if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
+    // The picture goes to OUT with the extension .png: an OUT ending in .png would be both (and
+    // .PNG too on a file system that ignores case).
+    std::filesystem::path png = lo->out;
+    std::string ext = png.extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    png.replace_extension(".png");
+    if (ext == ".png")
+      throw_input("field line", "--out", lo->out, "the CSV and its picture (the same name with .png) would be the same file",
+                  "a CSV name not ending in .png, e.g. " + std::filesystem::path(lo->out).replace_extension(".csv").string());
     nip::check_field_options(lo->c.field, "field line");
     const nip::FieldSetup s = nip::make_field_setup(lo->c.field);
     std::vector<std::vector<double>> rows;
@@ -152,8 +162,6 @@ nipdem::cli::Register reg([](CLI::App& app) {
                                                s.field->describe(), lo->c.field.preset, s.radius_m) +
                                        io::format_csv(columns, rows, std::vector<std::string>(columns.size(), "{:.9g}")));
     // The picture of the same data (thesis fig. 2.12 analogue), next to the CSV.
-    std::filesystem::path png = lo->out;
-    png.replace_extension(".png");
     io::PlotSpec plot;
     plot.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius_m * 1e6, lo->y * 1e6);
     plot.x_label = "x [um] (magnet edge = 0)";
