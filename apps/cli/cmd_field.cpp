@@ -1,7 +1,10 @@
 // `nipdem field probe|line`: the magnet field (analytic preset or imported map), its gradient and
 // the magnet force on a toner particle (thesis §2.4.2 eq. 2.4.34, §4.5 eq. 4.5.1; fig. 2.12 analogue).
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <fmt/format.h>
 #include <memory>
 #include <optional>
@@ -19,6 +22,48 @@
 
 namespace {
 using namespace nipdem;
+
+// The magnet's material (closed polygons, [m]) holds no toner: the field there is the one inside a
+// magnet, and on the blocks' corners the analytic field is singular (log; NaN exactly on one). A
+// point on or inside a block is refused, naming the options that placed it; `top` is the highest
+// point of the material (below it a point may be outside the blocks too, above it always is).
+bool on_or_in(Vec2 p, const std::vector<Vec2>& v) {
+  bool in = false;
+  for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
+    const Vec2 a = v[j], b = v[i], ab = b - a, ap = p - a;
+    const double len2 = norm2(ab);
+    const double t = len2 > 0 ? std::clamp(dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
+    if (norm(ap - t * ab) <= 1e-12 * std::sqrt(len2)) return true;  // on the edge (round-off of its length)
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * ab.x / ab.y) in = !in;
+  }
+  return in;
+}
+struct Material {
+  std::vector<std::vector<Vec2>> blocks;
+  double top = -std::numeric_limits<double>::infinity();
+  explicit Material(const magnet::MagnetField& f) : blocks(f.material()) {
+    for (const auto& poly : blocks)
+      for (const Vec2& v : poly) top = std::max(top, v.y);
+  }
+  void require_outside(Vec2 p, const std::string& where, const std::string& keys, const std::string& allowed_prefix) const {
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      if (on_or_in(p, blocks[k]))
+        throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
+                    fmt::format("the point lies on or inside the magnet (block {} of {}): the field there is not one a toner "
+                                "can feel, and it is singular on the blocks' corners",
+                                k + 1, blocks.size()),
+                    fmt::format("{} outside the magnet's blocks, e.g. y > {:g} m (their top)", allowed_prefix, top));
+  }
+};
+// Backstop for what the material test cannot see (a point next to a corner, a map with a tiny
+// spacing): every value printed must be finite.
+void require_finite(const std::vector<double>& values, Vec2 p, const std::string& where, const std::string& keys,
+                    const std::string& allowed) {
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
+                  "the field or the force is not finite there (a magnet corner or edge, where the field is singular)", allowed);
+}
 
 // The magnet, toner and radius options of probe and line (nip/presets.hpp), and --json.
 struct Common {
@@ -61,7 +106,18 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->add_option("--x", po->x, "x [m] along the process direction, 0 at the magnet edge")->required();
   probe->add_option("--y", po->y, "y [m] above the imaging-roller surface")->required();
   probe->callback([po] {
+    const std::string keys = "--x, --y";
+    require_range("field probe", "--x", po->x, -1.0, 1.0);
+    require_range("field probe", "--y", po->y, -1.0, 1.0);
+    if (po->c.field.map.empty()) {  // an analytic magnet knows its material (a map does not)
+      nip::check_field_options(po->c.field, "field probe");
+      Material(*nip::make_field_setup(po->c.field).field).require_outside({po->x, po->y}, "field probe", keys, "a point");
+    }
     const nlohmann::json j = nip::field_probe(po->c.field, po->x, po->y);
+    std::vector<double> values;
+    for (const auto& [k, v] : j.items())
+      if (v.is_number()) values.push_back(v.get<double>());
+    require_finite(values, {po->x, po->y}, "field probe", keys, "a point off the magnet's corners and edges");
     if (po->c.json) {
       cli::print_json(j.dump());
     } else {
@@ -81,10 +137,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
   exp->add_option("--preset", eo->preset, "magnet preset: black or color")->capture_default_str();
   exp->add_option("--x0", eo->x0, "first x [m]")->capture_default_str();
   exp->add_option("--x1", eo->x1, "last x [m]")->capture_default_str();
-  exp->add_option("--nx", eo->nx, "nodes along x (>= 5)")->capture_default_str();
+  // Ranges checked on the text, as for `field line --n` below.
+  exp->add_option("--nx", eo->nx, "nodes along x, in [5, 1e5]")->capture_default_str()->check(CLI::Range(5, 100000).description(""));
   exp->add_option("--y0", eo->y0, "first y [m]")->capture_default_str();
   exp->add_option("--y1", eo->y1, "last y [m]")->capture_default_str();
-  exp->add_option("--ny", eo->ny, "nodes along y (>= 5)")->capture_default_str();
+  exp->add_option("--ny", eo->ny, "nodes along y, in [5, 1e5]")->capture_default_str()->check(CLI::Range(5, 100000).description(""));
   exp->add_option("--out", eo->out, "output CSV file (written atomically)")->required();
   exp->callback([eo] {
     require_range("field export", "--nx", eo->nx, 5, 1e5);
@@ -110,16 +167,29 @@ nipdem::cli::Register reg([](CLI::App& app) {
   line->add_option("--y", lo->y, "height above the roller surface [m]")->capture_default_str();
   line->add_option("--x0", lo->x0, "first x [m]")->capture_default_str();
   line->add_option("--x1", lo->x1, "last x [m]")->capture_default_str();
-  line->add_option("--n", lo->n, "number of points")->capture_default_str();
-  line->add_option("--out", lo->out, "output CSV file (written atomically)")->required();
+  // The range is checked on the text (a value beyond int was "Could not convert", without the
+  // range); no description, so that the type stays INT for main.cpp's plain-integer check.
+  line->add_option("--n", lo->n, "number of points, in [2, 1e6]")->capture_default_str()->check(CLI::Range(2, 1000000).description(""));
+  line->add_option("--out", lo->out, "output CSV file (written atomically); its picture goes next to it, the name with .png (so not itself a .png)")->required();
   line->callback([lo] {
     require_range("field line", "--n", lo->n, 2, 1e6);
     require_range("field line", "--y", lo->y, -1.0, 1.0);
     require_range("field line", "--x0", lo->x0, -1.0, 1.0);
     require_range("field line", "--x1", lo->x1, -1.0, 1.0);
     if (!(lo->x1 > lo->x0)) throw_input("field line", "--x1", fmt::format("{:g}", lo->x1), "must exceed x0", "> x0");
+    // The picture goes to OUT with the extension .png: an OUT ending in .png would be both (and
+    // .PNG too on a file system that ignores case).
+    std::filesystem::path png = lo->out;
+    std::string ext = png.extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    png.replace_extension(".png");
+    if (ext == ".png")
+      throw_input("field line", "--out", lo->out, "the CSV and its picture (the same name with .png) would be the same file",
+                  "a CSV name not ending in .png, e.g. " + std::filesystem::path(lo->out).replace_extension(".csv").string());
     nip::check_field_options(lo->c.field, "field line");
     const nip::FieldSetup s = nip::make_field_setup(lo->c.field);
+    const std::string keys = "--y, --x0, --x1, --n";
+    const Material material(*s.field);
     std::vector<std::vector<double>> rows;
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;
@@ -129,10 +199,12 @@ nipdem::cli::Register reg([](CLI::App& app) {
     sfy.label = "F_y [nN]";
     for (int i = 0; i < lo->n; ++i) {
       const double x = lo->x0 + (lo->x1 - lo->x0) * i / (lo->n - 1);
+      material.require_outside({x, lo->y}, "field line", keys, "a line");
       const auto smp = s.field->at({x, lo->y});
       const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
       const Vec2 F = magnet::dipole_force(m, smp);
       rows.push_back({x, lo->y, smp.B.x, smp.B.y, norm(smp.B), smp.dB.xx, smp.dB.xy, smp.dB.yx, smp.dB.yy, m.x, m.y, F.x, F.y, norm(F)});
+      require_finite(rows.back(), {x, lo->y}, "field line", keys, "a line off the magnet's corners and edges");
       if (i > 0 && (prev_fx > 0) != (F.x > 0))  // linear interpolation of the sign change of F_x
         crossings.push_back(prev_x + (x - prev_x) * prev_fx / (prev_fx - F.x));
       prev_fx = F.x;
@@ -149,8 +221,6 @@ nipdem::cli::Register reg([](CLI::App& app) {
                                                s.field->describe(), lo->c.field.preset, s.radius_m) +
                                        io::format_csv(columns, rows, std::vector<std::string>(columns.size(), "{:.9g}")));
     // The picture of the same data (thesis fig. 2.12 analogue), next to the CSV.
-    std::filesystem::path png = lo->out;
-    png.replace_extension(".png");
     io::PlotSpec plot;
     plot.title = fmt::format("Magnet field and force on a toner of R = {:.3g} um at y = {:.3g} um", s.radius_m * 1e6, lo->y * 1e6);
     plot.x_label = "x [um] (magnet edge = 0)";

@@ -4,6 +4,7 @@
 // words with the unit (io::column_words: "front_std_m" with --yscale 1e6 -> "front std [µm]").
 #include <cmath>
 #include <cstdio>
+#include <fmt/format.h>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -13,6 +14,34 @@
 #include "registry.hpp"
 
 namespace {
+
+// Largest magnitude drawn: the axis range (with its padding) of values up to this stays finite.
+constexpr double kMaxPlotted = 1e300;
+// --xscale / --yscale: non-zero (0 collapses the axis) and not absurd.
+constexpr double kMinScale = 1e-30, kMaxScale = 1e30;
+
+void check_scale(const char* key, double s) {
+  if (!(std::abs(s) >= kMinScale && std::abs(s) <= kMaxScale))
+    nipdem::throw_input("plot", key, fmt::format("{:g}", s), "out of range",
+                        fmt::format("{:g} <= |{}| <= {:g} (negative flips the axis)", kMinScale, key, kMaxScale));
+}
+
+// Multiplies column `col` of `t` by `scale` (option `key`); a finite value that the scale takes
+// beyond +-kMaxPlotted (or that is already beyond it) cannot be drawn: refused naming the file,
+// line, column and option. Non-finite values stay non-finite (gaps in the line).
+std::vector<double> scaled_column(const nipdem::io::CsvTable& t, const std::string& col, double scale, const char* key) {
+  std::vector<double> v = t.column(col);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const double s = v[i] * scale;
+    if (std::isfinite(v[i]) && !(std::abs(s) <= kMaxPlotted))
+      nipdem::throw_input(fmt::format("{}:{}", t.source, i < t.lines.size() ? t.lines[i] : i + 2),
+                          scale == 1.0 ? fmt::format("column '{}'", col) : fmt::format("column '{}' x {}", col, key),
+                          scale == 1.0 ? fmt::format("{:g}", v[i]) : fmt::format("{:g} x {:g}", v[i], scale), "too large to draw",
+                          scale == 1.0 ? fmt::format("|value| <= {:g}", kMaxPlotted) : fmt::format("|value x {}| <= {:g}", key, kMaxPlotted));
+    v[i] = s;
+  }
+  return v;
+}
 
 struct Opts {
   std::string data, x, out, title, xlabel, ylabel;
@@ -44,7 +73,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--height", o->height, "image height [px]")->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
+    check_scale("--xscale", o->xscale);
+    check_scale("--yscale", o->yscale);
     const auto t = nipdem::io::read_csv(o->data);
+    if (t.rows.empty())
+      nipdem::throw_input(o->data, "rows", "0", "no data rows after the header: nothing to plot", ">= 1 data row");
     if (!o->yerr.empty() && o->yerr.size() != o->y.size())
       nipdem::throw_input("plot", "--yerr", std::to_string(o->yerr.size()) + " columns",
                           "needs one error column per --y column", std::to_string(o->y.size()));
@@ -59,21 +92,23 @@ nipdem::cli::Register reg([](CLI::App& app) {
     p.log_y = o->logy;
     p.width = o->width;
     p.height = o->height;
-    auto x = t.column(o->x);
-    for (double& v : x) v *= o->xscale;
+    const auto x = scaled_column(t, o->x, o->xscale, "--xscale");
+    bool any_point = false;  // a row with finite x and y in some series
     for (std::size_t k = 0; k < o->y.size(); ++k) {
       nipdem::io::Series s;
       s.label = !o->labels.empty() ? o->labels[k]
                 : o->y.size() > 1 || !o->yerr.empty() ? nipdem::io::column_words(o->y[k], o->yscale) : "";
       s.x = x;
-      s.y = t.column(o->y[k]);
-      for (double& v : s.y) v *= o->yscale;
-      if (!o->yerr.empty()) s.y_err = t.column(o->yerr[k]);
-      for (double& v : s.y_err) v *= std::abs(o->yscale);
+      s.y = scaled_column(t, o->y[k], o->yscale, "--yscale");
+      if (!o->yerr.empty()) s.y_err = scaled_column(t, o->yerr[k], std::abs(o->yscale), "--yscale");
+      for (std::size_t i = 0; i < x.size(); ++i) any_point = any_point || (std::isfinite(x[i]) && std::isfinite(s.y[i]));
       s.markers = o->markers || o->no_lines;
       s.line = !o->no_lines;
       p.series.push_back(std::move(s));
     }
+    if (!any_point)
+      nipdem::throw_input(o->data, "--x, --y", o->x + " vs " + fmt::format("{}", fmt::join(o->y, ",")),
+                          "no row has finite values in both columns: nothing to plot", ">= 1 row with finite x and y");
     nipdem::io::write_plot_png(o->out, p);
     if (o->json)
       nipdem::cli::print_json(nlohmann::json{{"png", o->out}, {"rows", t.rows.size()}, {"series", o->y.size()}}.dump());

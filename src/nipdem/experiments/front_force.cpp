@@ -18,6 +18,9 @@ namespace {
 constexpr const char* kWhere = "experiment front-force";
 // The print voltage of §2.5.1 ("alternatively 0 or 40 Volt") when the configuration has no [print].
 constexpr double kThesisPrintVoltage_V = 40.0;
+// Largest print voltage [V]: far above any DI print voltage (tens of V), and small enough that the
+// forces stay finite (1e308 V gave null results, exit 0).
+constexpr double kMaxVoltage_V = 1e4;
 
 // Grey dashed horizontal line at y over [x0, x1] (x in m, plotted in µm).
 io::Series reference_line(const std::string& label, double x0, double x1, double y) {
@@ -33,8 +36,9 @@ io::Series reference_line(const std::string& label, double x0, double x1, double
 
 void FrontForceOptions::validate() const {
   require_range(kWhere, "--gap", gap_m, 20e-6, 5e-3);
-  if (!std::isfinite(voltage_V) || voltage_V < 0)
-    throw_input(kWhere, "--voltage", fmt::format("{:g}", voltage_V), "out of range", "[0, inf) (0: the configuration's)");
+  if (!(voltage_V >= 0 && voltage_V <= kMaxVoltage_V))
+    throw_input(kWhere, "--voltage", fmt::format("{:g}", voltage_V), "out of range",
+                fmt::format("[0, {:g}] V (0: the configuration's)", kMaxVoltage_V));
   if (l_m.empty()) throw_input(kWhere, "--l", "", "need at least one distance");
   for (double l : l_m) require_range(kWhere, "--l", l, 1e-8, 1e-4);
   if (!(x_max_m > x_min_m)) throw_input(kWhere, "--x-max", fmt::format("{:g}", x_max_m), "must exceed --x-min", fmt::format("> {:g}", x_min_m));
@@ -44,6 +48,19 @@ void FrontForceOptions::validate() const {
   if ((x_max_m - x_min_m) / dx_m > 1e5) throw_input(kWhere, "--dx", fmt::format("{:g}", dx_m), "more than 1e5 points per row", ">= (x_max - x_min) / 1e5");
   if (!(front_x_max_m >= front_x_min_m))
     throw_input(kWhere, "--front-x-max", fmt::format("{:g}", front_x_max_m), "below --front-x-min", fmt::format(">= {:g}", front_x_min_m));
+  // The front region's results (crossing distance, share to the drum) come from the x grid: a
+  // region outside it, or in part outside it, would be reported from fewer points or none at all
+  // (all zeros before), so it must lie within [--x-min, --x-max] and hold a grid point.
+  for (const auto& [key, v] : {std::pair{"--front-x-min", front_x_min_m}, std::pair{"--front-x-max", front_x_max_m}})
+    if (!(v >= x_min_m && v <= x_max_m))
+      throw_input(kWhere, key, fmt::format("{:g}", v), "the front region must lie within the x range",
+                  fmt::format("[{:g}, {:g}] (--x-min, --x-max)", x_min_m, x_max_m));
+  const double first = std::ceil((front_x_min_m - x_min_m) / dx_m - 1e-3);  // first grid index in the region
+  const double last = std::floor((x_max_m - x_min_m) / dx_m + 1e-9);           // last grid index (front_force's nx - 1)
+  if (!(first <= last && x_min_m + first * dx_m <= front_x_max_m + 1e-3 * dx_m))
+    throw_input(kWhere, "--front-x-min, --front-x-max", fmt::format("[{:g}, {:g}]", front_x_min_m, front_x_max_m),
+                fmt::format("front region holds no point of the x grid (--x-min {:g} step --dx {:g})", x_min_m, dx_m),
+                "a region holding at least one grid point (widen it or make --dx smaller)");
 }
 
 FrontForcePoint FrontForceModel::at(double x, double l) const {
@@ -97,6 +114,9 @@ FrontForceModel make_front_force_model(const ExperimentOptions& e, const FrontFo
       for (const auto& s : segs) v = std::max(v, std::fabs(s.voltage_V - m.cfg.electric.pattern.off_voltage()));
     }
   }
+  if (!(v <= kMaxVoltage_V))  // the configuration's print voltage, where --voltage was 0
+    throw_input(kWhere, "[print] voltage of the configuration (used as --voltage is 0)", fmt::format("{:g}", v), "out of range",
+                fmt::format("[0, {:g}] V", kMaxVoltage_V));
   m.voltage_V = v;
   return m;
 }

@@ -19,10 +19,26 @@ analysis::VoSearchOptions search_options(const VoOptions& v) {
   return {.v0_V = v.v0_V, .step_V = v.step_V, .v_max_V = v.v_max_V, .coarse_step_V = v.coarse_step_V};
 }
 
+// Largest |voltage| of the search [V]: far above any Vo-level (tens of V, §5.2). Without a bound
+// --v0 -1e308 made the step count overflow and the search ran no line at all (exit 0, found false).
+constexpr double kMaxVoltage_V = 1e4;
+// The search's own limit on the steps of one seed (analysis::find_vo_level), checked here first so
+// that the message names the options.
+constexpr double kMaxSteps = 1e5;
+
 void check(const VoOptions& v) {
-  require_range("experiment vo-level", "--step", v.step_V, 1e-3, 100.0);
-  if (v.seeds < 1 || v.seeds > 100000) throw_input("experiment vo-level", "--seeds", std::to_string(v.seeds), "out of range", "[1, 100000]");
-  check_print_options("experiment vo-level", v.print);
+  const std::string where = "experiment vo-level";
+  require_range(where, "--step", v.step_V, 1e-3, 100.0);
+  require_range(where, "--v0", v.v0_V, -kMaxVoltage_V, kMaxVoltage_V);
+  require_range(where, "--vmax", v.v_max_V, v.v0_V, kMaxVoltage_V);  // the step is > 0: upwards from --v0
+  require_range(where, "--coarse-step", v.coarse_step_V, 0.0, 2 * kMaxVoltage_V);
+  const double steps = std::floor((v.v_max_V - v.v0_V) / v.step_V + 1e-9);  // as find_vo_level counts them
+  if (steps > kMaxSteps)
+    throw_input(where, "--step", fmt::format("{:g}", v.step_V),
+                fmt::format("{:g} steps per seed from --v0 {:g} to --vmax {:g}", steps, v.v0_V, v.v_max_V),
+                fmt::format(">= (vmax - v0) / {:g}", kMaxSteps));
+  if (v.seeds < 1 || v.seeds > 100000) throw_input(where, "--seeds", std::to_string(v.seeds), "out of range", "[1, 100000]");
+  check_print_options(where, v.print);
   // the search options are checked once here (exit 2), not in every seed's task
   analysis::find_vo_level([](double) { return 1L; }, search_options(v));
 }

@@ -16,6 +16,10 @@ namespace nipdem::io {
 
 namespace {
 
+// Largest |Bx|, |By| a map file may hold [T]: far above any magnet (a few T), and small enough that
+// the force and the gradients stay finite. A larger value is refused naming file, line and column.
+constexpr double kMaxFieldMapB_T = 100.0;
+
 // 4th-order first derivative (in index units) of samples v[k*stride], k = 0..n-1, at index i.
 double d1(const double* v, int n, int stride, int i) {
   auto f = [&](int k) { return v[static_cast<std::ptrdiff_t>(k) * stride]; };
@@ -215,6 +219,14 @@ FieldMap FieldMap::from_csv(std::string_view text, const std::string& where) {
       if (!std::isfinite(v[c]))
         throw_input(lw, names[c], "'" + cols[static_cast<std::size_t>(c)] + "'", "value is NaN or infinite",
                     "finite numbers");
+    }
+    // A flux density no magnet makes (a typo, a wrong unit, 1e308) would overflow the force or
+    // its gradients: refused here, with its line and column, not met later as a NaN.
+    for (int c = 2; c < 4; ++c) {
+      const double b = v[c] * (c == 2 ? fb : fb2);
+      if (!(std::abs(b) <= kMaxFieldMapB_T))
+        throw_input(lw, fmt::format("{} (column {})", names[c], c + 1), "'" + cols[static_cast<std::size_t>(c)] + "'",
+                    fmt::format("not a physical flux density ({:g} T)", b), fmt::format("|{}| <= {:g} T", names[c], kMaxFieldMapB_T));
     }
     xs.push_back(v[0] * fx);
     ys.push_back(v[1] * fy);
