@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "nipdem/core/error.hpp"
+#include "nipdem/io/atomic_file.hpp"
 
 namespace nipdem::io {
 
@@ -544,6 +545,7 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
   cairo_surface_flush(surf.get());
   // Atomic write: temp PNG in the same folder, then rename.
   static std::atomic<unsigned> counter{0};
+  check_replaceable(path);  // (a folder, a device, an empty path: refused naming it)
   if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
   std::filesystem::path tmp = path;
   tmp += fmt::format(".tmp.{}.{}.png", ::getpid(), counter++);
@@ -553,7 +555,12 @@ void write_plot_png(const std::filesystem::path& path, const PlotSpec& spec) {
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error(where + ": cannot write PNG: " + cairo_status_to_string(st));
   }
-  std::filesystem::rename(tmp, path);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {  // no temp file left behind
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(where + ": cannot replace " + path.string() + " by the new picture");
+  }
 }
 
 std::string column_words(const std::string& column, double scale) {
