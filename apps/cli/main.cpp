@@ -1,5 +1,7 @@
 // nipdem: one executable, subcommands registered by the cmd_*.cpp files (see registry.hpp).
+#include <cctype>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -94,8 +96,11 @@ bool plain_integer(const std::string& s, bool allow_sign) {
 }
 void harden_numeric_options(CLI::App* app) {
   for (CLI::Option* o : app->get_options()) {
+    // (the type name carries a validator's description after it, e.g. "INT in [1 - 256]" for
+    // CLI::Range: matched by its start, or such an option escaped the check: --jobs 010)
     const std::string t = o->get_type_name();
-    if (t == "FLOAT") {
+    auto is = [&t](const char* type) { return t.rfind(type, 0) == 0 && (t.size() == std::strlen(type) || !std::isalnum(static_cast<unsigned char>(t[std::strlen(type)]))); };
+    if (is("FLOAT")) {
       o->check(CLI::Validator(
           [](std::string& v) -> std::string {
             char* end = nullptr;
@@ -104,8 +109,8 @@ void harden_numeric_options(CLI::App* app) {
             return {};
           },
           "", "finite"));
-    } else if (t == "INT" || t == "UINT") {
-      const bool sign = t == "INT";
+    } else if (is("INT") || is("UINT")) {
+      const bool sign = is("INT");
       o->check(CLI::Validator(
           [sign](std::string& v) -> std::string {
             if (!plain_integer(v, sign))

@@ -66,7 +66,11 @@ TEST(HostileOutput, OutputPathsThatAreNotFilesAreRefusedAndLeftAlone) {
   const fs::path fifo = d / "fifo", folder = d / "folder";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);  // a device node (e.g. /dev/null) is the same case for a root user
   fs::create_directories(folder);
+  const fs::path csv = d / "g.csv";
+  nipdem::io::write_file_atomic(csv, "a_m,b_N\n1,2\n2,3\n");
   expect_refused({{"field export --out " + fifo.string(), {fifo.string(), "not a regular file"}},
+                  {"plot " + csv.string() + " --x a_m --y b_N --out " + fifo.string(), {fifo.string(), "not a regular file"}},
+                  {"plot " + csv.string() + " --x a_m --y b_N --out " + folder.string(), {folder.string(), "folder"}},
                   {"field export --out " + folder.string(), {folder.string(), "folder"}},
                   {"field export --out ''", {"output path is empty"}},
                   {"field line --out " + fifo.string(), {fifo.string()}}},
@@ -153,4 +157,13 @@ TEST(HostileOutput, ClusterTemplatesAndRoughnessAreCheckedWhereTheyAreRead) {
   const auto r = nipdem::test::run_cli_bounded(run + " --set geometry.roughness.spacing_m=0", "hostile_out_config", 300);
   EXPECT_EQ(r.status, 0) << r.err;
   fs::remove_all(d);
+}
+
+// ---- integer options that carry a range check are plain integers too ----
+TEST(HostileOutput, IntegerOptionsWithARangeAreStillPlainDecimal) {
+  // CLI::Range's description changed the option's type name ("INT in [1 - 256]"), so the check
+  // for plain decimal integers skipped it: --jobs 010 was read as octal 8 and accepted.
+  expect_refused({{"experiment vo-level --jobs 010", {"--jobs", "octal"}},
+                  {"experiment edge-sharpness --jobs 0x10", {"--jobs"}}},
+                 "hostile_out_int");
 }
