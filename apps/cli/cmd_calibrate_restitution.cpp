@@ -21,12 +21,12 @@ nipdem::cli::Register reg([](CLI::App& app) {
   auto* sub = cal->add_subcommand("restitution", "Normal restitution coefficient from a drop test with Stokes drag (thesis 4.2.1)");
   auto o = std::make_shared<Opts>();
   sub->add_option("--y0", o->p.y0_m, "drop height [m]")->required();
-  sub->add_option("--y1", o->p.y1_m, "maximum rebound height [m], 0 < y1 <= y0")->required();
+  sub->add_option("--y1", o->p.y1_m, "maximum rebound height [m], 1e-9 <= y1 <= y0")->required();
   sub->add_option("--radius", o->p.radius_m, "sphere radius [m]")->required();
   sub->add_option("--density", o->p.density_kg_per_m3, "sphere density [kg/m^3]")->required();
   sub->add_option("--viscosity", o->p.viscosity_Pa_s, "air dynamic viscosity [Pa s]")->required();
   sub->add_option("--gravity", o->p.gravity_m_per_s2, "gravitational acceleration [m/s^2]")->capture_default_str();
-  sub->add_option("--air-density", o->p.air_density_kg_per_m3, "air density, only for the Reynolds number [kg/m^3]")
+  sub->add_option("--air-density", o->p.air_density_kg_per_m3, "air density, for the Reynolds number and the Schiller-Naumann check [kg/m^3], 0 .. 1000")
       ->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
