@@ -3,6 +3,7 @@
 // See src/nipdem/experiments/calibrate_adhesion.hpp and docs/calibration.md.
 #include <fmt/format.h>
 #include <memory>
+#include <utility>
 
 #include "nipdem/core/error.hpp"
 #include "nipdem/experiments/calibrate_adhesion.hpp"
@@ -34,11 +35,21 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--level", c->o.level, "interval level of the median")->capture_default_str();
   sub->add_option("--out", c->out, "output folder (default runs/calibrate_adhesion)");
   sub->add_flag("--json", c->json, "print one JSON object on stdout");
-  sub->callback([c] {
+  sub->callback([c, sub] {
     using namespace nipdem::calibrate;
     if (c->method == "centrifugal") c->o.method = AdhesionMethod::centrifugal;
     else if (c->method == "afm") c->o.method = AdhesionMethod::afm;
     else nipdem::throw_input("calibrate adhesion", "--method", "\"" + c->method + "\"", "unknown method", "centrifugal or afm");
+    // Options given explicitly are checked even where "not given" has a meaning, and an option
+    // the method does not use is refused rather than ignored silently.
+    const char* w = "calibrate adhesion";
+    if (c->o.method == AdhesionMethod::afm)
+      for (const char* opt : {"--particle-mass-kg", "--rotor-radius-m", "--initial-count", "--bootstrap", "--seed"})
+        if (sub->count(opt) > 0)
+          nipdem::throw_input(w, opt, "", "only the centrifugal method uses it (afm: the forces are measured directly)",
+                              "--method centrifugal");
+    for (const auto& [opt, v] : {std::pair{"--measured-diameter-m", c->o.measured_diameter_m}, std::pair{"--d50-m", c->o.d50_m}})
+      if (sub->count(opt) > 0) nipdem::require_range(w, opt, v, 1e-7, 1e-2);  // 0.1 um .. 1 cm
     c->o.validate();
     const Record r = read_adhesion_record(c->data, c->o.method);
     const AdhesionResult a = calibrate_adhesion(r, c->o);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <memory>
 
+#include "nipdem/core/error.hpp"
 #include "nipdem/experiments/calibrate_friction.hpp"
 #include "registry.hpp"
 
@@ -33,9 +34,17 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--blocks", c->o.blocks, "batch means for the plateau's standard error")->capture_default_str();
   sub->add_option("--out", c->out, "output folder (default runs/calibrate_friction)");
   sub->add_flag("--json", c->json, "print one JSON object on stdout");
-  sub->callback([c] {
+  sub->callback([c, sub] {
     using namespace nipdem::calibrate;
     c->o.setup = parse_friction_setup(c->setup);
+    // An option of the other set-up given explicitly would be ignored silently: refused.
+    if (c->o.setup == FrictionSetup::capstan && sub->count("--sample-mass-kg") > 0)
+      nipdem::throw_input("calibrate friction", "--sample-mass-kg", fmt::format("{:g}", c->o.sample_mass_kg),
+                          "only the plate set-up has a sample plate (capstan: the load is --weight-mass-kg alone)",
+                          "--setup plate");
+    if (c->o.setup == FrictionSetup::plate && sub->count("--wrap-angle-rad") > 0)
+      nipdem::throw_input("calibrate friction", "--wrap-angle-rad", fmt::format("{:g}", c->o.wrap_angle_rad),
+                          "only the capstan set-up has a wrap angle", "--setup capstan");
     c->o.validate();
     const Record r = read_friction_record(c->data);
     const FrictionResult f = calibrate_friction(r, c->o);

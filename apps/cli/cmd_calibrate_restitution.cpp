@@ -21,26 +21,32 @@ nipdem::cli::Register reg([](CLI::App& app) {
   auto* sub = cal->add_subcommand("restitution", "Normal restitution coefficient from a drop test with Stokes drag (thesis 4.2.1)");
   auto o = std::make_shared<Opts>();
   sub->add_option("--y0", o->p.y0_m, "drop height [m]")->required();
-  sub->add_option("--y1", o->p.y1_m, "maximum rebound height [m], 0 < y1 <= y0")->required();
+  sub->add_option("--y1", o->p.y1_m, "maximum rebound height [m], 1e-9 <= y1 <= y0")->required();
   sub->add_option("--radius", o->p.radius_m, "sphere radius [m]")->required();
   sub->add_option("--density", o->p.density_kg_per_m3, "sphere density [kg/m^3]")->required();
   sub->add_option("--viscosity", o->p.viscosity_Pa_s, "air dynamic viscosity [Pa s]")->required();
   sub->add_option("--gravity", o->p.gravity_m_per_s2, "gravitational acceleration [m/s^2]")->capture_default_str();
-  sub->add_option("--air-density", o->p.air_density_kg_per_m3, "air density, only for the Reynolds number [kg/m^3]")
+  sub->add_option("--air-density", o->p.air_density_kg_per_m3, "air density, for the Reynolds number and the Schiller-Naumann check [kg/m^3], 0 .. 1000")
       ->capture_default_str();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
     // Physical ranges (a drop test of a particle), so that no result overflows into null.
     const char* w = "calibrate restitution";
     nipdem::require_range(w, "--y0", o->p.y0_m, 1e-9, 100.0);
+    nipdem::require_range(w, "--y1", o->p.y1_m, 1e-9, 100.0);  // and <= y0 (checked with its own message)
     nipdem::require_range(w, "--radius", o->p.radius_m, 1e-9, 1e-1);
     nipdem::require_range(w, "--density", o->p.density_kg_per_m3, 1e-3, 1e5);
     nipdem::require_range(w, "--viscosity", o->p.viscosity_Pa_s, 1e-9, 1e3);
     nipdem::require_range(w, "--gravity", o->p.gravity_m_per_s2, 1e-3, 1e3);
+    nipdem::require_range(w, "--air-density", o->p.air_density_kg_per_m3, 0.0, 1e3);  // 0: vacuum
     const auto r = nipdem::calibrate::drop_test_restitution(o->p);
-    for (double v : {r.restitution, r.impact_speed_m_per_s, r.rebound_speed_m_per_s, r.fall_time_s, r.beta_s})
+    // Every printed number must be finite (JSON would print null).
+    for (double v : {r.restitution, r.restitution_no_drag, r.reynolds_at_impact, r.restitution_schiller_naumann,
+                     r.impact_speed_m_per_s, r.impact_speed_no_drag_m_per_s, r.rebound_speed_m_per_s, r.fall_time_s,
+                     r.rise_time_s, r.beta_s, r.terminal_speed_m_per_s, r.mass_kg})
       if (!std::isfinite(v))
-        nipdem::throw_input(w, "--y0, --y1, --radius, --density, --viscosity", "", "the drop test is not computable for these inputs");
+        nipdem::throw_input(w, "--y0, --y1, --radius, --density, --viscosity, --gravity, --air-density", "",
+                            "the drop test is not computable for these inputs");
     if (o->json) {
       nlohmann::json j{{"restitution", r.restitution},
                        {"restitution_no_drag", r.restitution_no_drag},

@@ -19,6 +19,12 @@ namespace nipdem::calibrate {
 
 namespace {
 constexpr const char* kWhere = "calibrate adhesion";
+constexpr double kMinParticleMass = 1e-18, kMaxParticleMass = 1e-3;  // [kg]: a 0.1 um particle .. a 1 cm bead
+constexpr double kMinRotorRadius = 1e-3, kMaxRotorRadius = 10.0;     // [m]
+constexpr double kMaxBootstrapDraws = 5e8;
+// The config value must be one the config accepts (adhesion.*_force_N <= 1e-3 N, nip_config.cpp)
+// and not a degenerate one.
+constexpr double kMinConfigForce = 1e-15, kMaxConfigForce = 1e-3;  // [N]
 
 // Where the piecewise-linear interpolation of fraction(ln F) crosses level q; NaN if it never does.
 double crossing(const std::vector<double>& lnF, const std::vector<double>& frac, double q) {
@@ -72,12 +78,20 @@ double centrifugal_force(double m, double omega, double r) { return m * omega * 
 
 void AdhesionOptions::validate() const {
   if (method == AdhesionMethod::centrifugal) {
-    require_positive(kWhere, "--particle-mass-kg", particle_mass_kg);
-    require_positive(kWhere, "--rotor-radius-m", rotor_radius_m);
+    // Physical ranges (a toner-to-bead particle, a centrifuge rotor), so that F_c = m omega^2 r
+    // stays finite and the messages name these options, not the record (1e308 kg used to blame
+    // fraction_remaining, a 1e308 m rotor printed a config value of 4e300 N).
+    require_range(kWhere, "--particle-mass-kg", particle_mass_kg, kMinParticleMass, kMaxParticleMass);
+    require_range(kWhere, "--rotor-radius-m", rotor_radius_m, kMinRotorRadius, kMaxRotorRadius);
     require_range(kWhere, "--initial-count", initial_count, 10.0, 1e6);
     if (initial_count != std::floor(initial_count))
       throw_input(kWhere, "--initial-count", fmt::format("{:g}", initial_count), "not a whole number of particles", "10 .. 1e6");
     require_range(kWhere, "--bootstrap", bootstrap, 20, 100000);
+    // Each resample draws N0 particles: bound the work (~20 s at the limit), not each factor.
+    if (static_cast<double>(bootstrap) * initial_count > kMaxBootstrapDraws)
+      throw_input(kWhere, "--bootstrap, --initial-count", fmt::format("{} x {:g}", bootstrap, initial_count),
+                  fmt::format("{:g} particle draws for the bootstrap", static_cast<double>(bootstrap) * initial_count),
+                  fmt::format("--bootstrap x --initial-count <= {:g}", kMaxBootstrapDraws));
   }
   require_range(kWhere, "--measured-diameter-m", measured_diameter_m, 0.0, 1e-2);
   require_range(kWhere, "--d50-m", d50_m, 0.0, 1e-2);
@@ -162,6 +176,22 @@ AdhesionResult calibrate_adhesion(const Record& r, const AdhesionOptions& o) {
   a.config_value_N = a.scale * a.median_N;
   a.config_lo_N = a.scale * a.median_lo_N;
   a.config_hi_N = a.scale * a.median_hi_N;
+  const std::string keys = o.method == AdhesionMethod::centrifugal
+                               ? (a.scale != 1.0 ? "--particle-mass-kg, --rotor-radius-m, --measured-diameter-m, --d50-m"
+                                                 : "--particle-mass-kg, --rotor-radius-m")
+                               : "--measured-diameter-m, --d50-m";
+  if (!(a.config_value_N >= kMinConfigForce && a.config_value_N <= kMaxConfigForce))
+    throw_input(r.source, o.method == AdhesionMethod::afm && a.scale == 1.0 ? std::string("force_N") : keys,
+                fmt::format("{:g} N", a.config_value_N),
+                fmt::format("the {} this gives is not an adhesion force the config accepts (median {:g} N x size scale "
+                            "{:g})",
+                            a.config_key, a.median_N, a.scale),
+                fmt::format("[{:g}, {:g}] N", kMinConfigForce, kMaxConfigForce));
+  for (double v : {a.dist.mu_ln, a.dist.sigma_ln, a.mu_ln_std, a.sigma_ln_std, a.median_std_N, a.median_lo_N,
+                   a.median_hi_N, a.mean_N, a.q10_N, a.q90_N, a.config_lo_N, a.config_hi_N, a.rms_residual})
+    if (!std::isfinite(v))
+      throw_input(r.source, keys, "", "the fitted distribution has no finite mean, quantile or interval",
+                  "a record the log-normal describes with a moderate spread");
   return a;
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <fmt/format.h>
 
 #include "nipdem/core/error.hpp"
@@ -15,6 +16,7 @@ namespace nipdem::calibrate {
 
 namespace {
 constexpr const char* kWhere = "calibrate friction";
+constexpr double kMaxMu = 100.0;  // largest friction coefficient reported (rubber ~1-4, toner ~0.2-0.5)
 
 // Median absolute deviation of successive differences -> sd of white noise (sqrt 2 for the difference).
 double noise_from_differences(const std::vector<double>& f, std::size_t b, std::size_t e) {
@@ -55,10 +57,16 @@ FrictionSetup parse_friction_setup(const std::string& s) {
 const char* to_string(FrictionSetup s) { return s == FrictionSetup::plate ? "plate" : "capstan"; }
 
 void FrictionOptions::validate() const {
+  // Physical ranges of a bench measurement, so that the load force F_n = m g stays a finite,
+  // non-degenerate number (1e308 kg gave F_n = inf and mu = 0, 1e308 m/s^2 mu ~ 1e-308).
   if (setup == FrictionSetup::plate) require_range(kWhere, "--sample-mass-kg", sample_mass_kg, 0.0, 1e3);
-  require_positive(kWhere, "--weight-mass-kg", weight_mass_kg);
+  require_range(kWhere, "--weight-mass-kg", weight_mass_kg, 1e-6, 1e3);
+  const double mass = setup == FrictionSetup::plate ? sample_mass_kg + weight_mass_kg : weight_mass_kg;
   require_range(kWhere, "--mass-std-kg", mass_std_kg, 0.0, 1e3);
-  require_positive(kWhere, "--gravity-m-per-s2", gravity_m_per_s2);
+  if (mass_std_kg > mass)
+    throw_input(kWhere, "--mass-std-kg", fmt::format("{:g}", mass_std_kg),
+                fmt::format("larger than the loading mass itself ({:g} kg)", mass), fmt::format("[0, {:g}]", mass));
+  require_range(kWhere, "--gravity-m-per-s2", gravity_m_per_s2, 1e-3, 1e3);
   require_positive(kWhere, "--stick-end-m", stick_end_m);
   require_range(kWhere, "--transition-m", transition_m, 0.0, 1e3);
   require_range(kWhere, "--wrap-angle-rad", wrap_angle_rad, 1e-3, 100.0);
@@ -107,7 +115,8 @@ FrictionResult calibrate_friction(const Record& r, const FrictionOptions& o) {
   res.n_slide = n - i_slide;
   const std::size_t min_slide = static_cast<std::size_t>(4 * o.blocks);
   if (res.n_slide < min_slide)
-    throw_input(r.source, "--stick-end-m", fmt::format("{:g}", o.stick_end_m),
+    throw_input(r.source, o.transition_m > 0 ? "--stick-end-m + --transition-m" : "--stick-end-m",
+                fmt::format("{:g}", o.stick_end_m + o.transition_m),
                 fmt::format("only {} samples beyond stick end + transition ({:g} m); the last x is {:g} m", res.n_slide,
                             o.stick_end_m + o.transition_m, x.back()),
                 fmt::format(">= {} sliding samples (4 x --blocks)", min_slide));
@@ -175,6 +184,12 @@ FrictionResult calibrate_friction(const Record& r, const FrictionOptions& o) {
     throw_input(r.source, "force_N", fmt::format("{:g}", res.dynamic_force_N),
                 fmt::format("plateau force not above the hanging weight F_z = {:g} N: no capstan friction (eq. 4.3.3)", L),
                 fmt::format("> {:g} N", L));
+  if (o.setup == FrictionSetup::capstan && !(res.static_force_N > L))
+    throw_input(r.source, "force_N", fmt::format("{:g}", res.static_force_N),
+                fmt::format("static (stick peak) force not above the hanging weight F_z = {:g} N: no capstan friction "
+                            "(eq. 4.3.3); check --weight-mass-kg",
+                            L),
+                fmt::format("> {:g} N", L));
   res.mu_s = friction_coefficient(o, res.static_force_N, L);
   res.mu_d = friction_coefficient(o, res.dynamic_force_N, L);
   // Linear error propagation: d mu / mu = dF/F (+) dL/L (plate); d mu = (dF/F (+) dL/L) / theta (capstan).
@@ -184,6 +199,23 @@ FrictionResult calibrate_friction(const Record& r, const FrictionOptions& o) {
   };
   res.mu_s_std = spread(res.static_force_N, res.static_force_std_N);
   res.mu_d_std = spread(res.dynamic_force_N, res.dynamic_force_std_N);
+  // A coefficient outside (0, kMaxMu] (or not finite) means the load options do not belong to
+  // the record: refused rather than reported (the record's forces go up to 1e300 N).
+  const char* load_keys = o.setup == FrictionSetup::plate
+                              ? "--sample-mass-kg, --weight-mass-kg, --gravity-m-per-s2"
+                              : "--weight-mass-kg, --gravity-m-per-s2, --wrap-angle-rad";
+  for (const auto& [name, mu] : {std::pair{"mu_s", res.mu_s}, std::pair{"mu_d", res.mu_d}})
+    if (!(mu > 0 && mu <= kMaxMu))
+      throw_input(r.source, load_keys, "",
+                  fmt::format("{} = {:g} from the record's forces and the load force {:g} N: the load does not fit "
+                              "the record",
+                              name, mu, L),
+                  fmt::format("options giving 0 < mu <= {:g}", kMaxMu));
+  for (double v : {res.mu_s_std, res.mu_d_std, res.static_force_std_N, res.dynamic_force_std_N, res.load_force_std_N,
+                   res.noise_N})
+    if (!std::isfinite(v))
+      throw_input(r.source, "force_N", "", "the record's forces give no finite uncertainty",
+                  "forces of a bench measurement");
   return res;
 }
 

@@ -19,6 +19,10 @@ namespace nipdem::calibrate {
 
 namespace {
 constexpr const char* kWhere = "calibrate magnetisation";
+constexpr double kMinVolumeFraction = 1e-3;
+// The config values must be ones the config accepts (magnet.*, nip_config.cpp).
+constexpr double kMinMs = 1e-3, kMaxMs = 1e7;      // [A/m]
+constexpr double kMinBsat = 1e-6, kMaxBsat = 10.0;  // [T]
 
 // Linear-saturated curve along one axis (models/magnetisation.hpp, §4.5): M for flux density B.
 double curve(double Ms, double Bs, double B) { return magnet::magnetisation({Ms, Bs, 1.0}, {B, 0.0}).x; }
@@ -39,8 +43,9 @@ Points effective(const Record& r, const MagnetisationOptions& o) {
 
 void MagnetisationOptions::validate() const {
   require_range(kWhere, "--demag-factor", demag_factor, 0.0, 1.0);
-  if (!(volume_fraction > 0.0 && volume_fraction <= 1.0))
-    throw_input(kWhere, "--volume-fraction", fmt::format("{:g}", volume_fraction), "out of range", "(0, 1]");
+  // A pigment fraction below 1e-3 is no magnetic toner and scales M = M_sample / eta far past
+  // any pigment (1e-300 made the fit blame the record, 1e-10 printed Ms = 4.5e15 A/m).
+  require_range(kWhere, "--volume-fraction", volume_fraction, kMinVolumeFraction, 1.0);
 }
 
 Record parse_vsm_record(std::string_view text, const std::string& source) {
@@ -101,6 +106,18 @@ MagnetisationFit calibrate_magnetisation(const Record& r, const MagnetisationOpt
   f.rms_residual_A_per_m = std::sqrt(fit.rss / static_cast<double>(n));
   f.iterations = fit.iterations;
   f.converged = fit.converged;
+  if (!(f.Ms_A_per_m >= kMinMs && f.Ms_A_per_m <= kMaxMs))
+    throw_input(r.source, o.volume_fraction < 1.0 ? "M_A_per_m, --volume-fraction" : "M_A_per_m",
+                fmt::format("Ms = {:g} A/m", f.Ms_A_per_m),
+                fmt::format("not a saturation magnetisation the config accepts (the record's M / volume fraction {:g})",
+                            o.volume_fraction),
+                fmt::format("[{:g}, {:g}] A/m", kMinMs, kMaxMs));
+  if (!(f.B_sat_T >= kMinBsat && f.B_sat_T <= kMaxBsat))
+    throw_input(r.source, o.demag_factor > 0 ? "H_A_per_m, --demag-factor" : "H_A_per_m", fmt::format("B_sat = {:g} T", f.B_sat_T),
+                "not a saturation flux the config accepts", fmt::format("[{:g}, {:g}] T", kMinBsat, kMaxBsat));
+  for (double v : {f.Ms_std_A_per_m, f.B_sat_std_T, f.corr, f.chi_linear, f.rms_residual_A_per_m})
+    if (!std::isfinite(v))
+      throw_input(r.source, "M_A_per_m", "", "the fit gives no finite uncertainty", "a record with spread on both parts");
   return f;
 }
 

@@ -81,19 +81,46 @@ YV rk4(const DragModel& d, YV s, double h) {
   return {s.y + h / 6 * (k1.y + 2 * k2.y + 2 * k3.y + k4.y), s.v + h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v)};
 }
 
+// Flight time scale: the drag-free fall time or the fall at the Stokes terminal speed.
+double time_scale(const DragModel& d, double height) {
+  const double beta = d.mass_kg / (6.0 * constants::pi * d.viscosity_Pa_s * d.radius_m);
+  const double g = d.gravity_m_per_s2;
+  return std::max(std::sqrt(2.0 * height / g), height / (beta * g));
+}
+
 // Step size: resolves both the flight time and the Stokes relaxation time.
 double step_for(const DragModel& d, double height) {
   const double beta = d.mass_kg / (6.0 * constants::pi * d.viscosity_Pa_s * d.radius_m);
-  const double g = d.gravity_m_per_s2;
-  const double T = std::max(std::sqrt(2.0 * height / g), height / (beta * g));
-  return std::min(beta / 20.0, T / 4000.0);
+  return std::min(beta / 20.0, time_scale(d, height) / 4000.0);
+}
+
+// Most RK4 steps one integration may take (~20 s); more means inputs far outside a drop test.
+constexpr long kMaxSteps = 100000000L;
+
+// Largest speed at which RK4 with step dt is still stable on the drag: the drag's rate
+// d(c v f(Re))/dv = c (1 + 0.15 * 1.687 Re^0.687) times dt must stay <= 2.5 (RK4 is unstable
+// from 2.79 on: the state oscillates, grows and ends in inf/NaN). Infinite for Stokes drag
+// (dt c <= 1/20 by step_for) and without air.
+double max_followed_speed(const DragModel& d, double dt) {
+  const double k = d.air_density_kg_per_m3 * 2.0 * d.radius_m / d.viscosity_Pa_s;  // Re per speed
+  if (!d.schiller_naumann || !(k > 0)) return std::numeric_limits<double>::infinity();
+  const double c = 6.0 * constants::pi * d.viscosity_Pa_s * d.radius_m / d.mass_kg;
+  const double re = std::pow((2.5 / (dt * c) - 1.0) / (0.15 * 1.687), 1.0 / 0.687);
+  return re / k;
 }
 
 // Integrates until event(state) <= 0 and returns the state at the event (bisected step).
+// Throws IntegrationLimit when the state leaves what the step can follow or the event is not
+// reached within kMaxSteps (results are unchanged wherever the integration succeeds).
 template <class Ev>
 YV integrate_to(const DragModel& d, YV s, double dt, Ev event) {
-  for (long n = 0; n < 100000000L; ++n) {
+  const double v_max = max_followed_speed(d, dt);
+  if (!(std::abs(s.v) <= v_max))
+    throw IntegrationLimit(fmt::format("speed {:g} m/s: the drag is too stiff for the integration step", s.v));
+  for (long n = 0; n < kMaxSteps; ++n) {
     const YV next = rk4(d, s, dt);
+    if (!(std::abs(next.v) <= v_max) || !std::isfinite(next.y))
+      throw IntegrationLimit(fmt::format("speed {:g} m/s: the drag is too stiff for the integration step", next.v));
     if (event(next) <= 0) {
       double lo = 0, hi = dt;
       for (int i = 0; i < 100; ++i) {
@@ -105,7 +132,7 @@ YV integrate_to(const DragModel& d, YV s, double dt, Ev event) {
     }
     s = next;
   }
-  throw std::runtime_error("drop test integration did not reach its event");
+  throw IntegrationLimit(fmt::format("drop test integration did not reach its event within {} steps", kMaxSteps));
 }
 
 }  // namespace
@@ -165,8 +192,19 @@ DropTestResult drop_test_restitution(const DropTestParams& p) {
                             "drag parameters",
                             r.restitution));
   // Schiller–Naumann cross-check: solve rise_height(v_f) = y1 for v_f by bisection.
-  {
-    const DragModel d{r.mass_kg, p.radius_m, p.viscosity_Pa_s, p.air_density_kg_per_m3, g, true};
+  // Inputs it cannot integrate (a fall of more than 5e6 relaxation times, or speeds at which the
+  // drag is too stiff for the explicit step) are refused naming the options, never a null result.
+  const DragModel d{r.mass_kg, p.radius_m, p.viscosity_Pa_s, p.air_density_kg_per_m3, g, true};
+  const std::string keys = "--y0, --y1, --radius, --density, --viscosity, --gravity, --air-density";
+  const double fall_steps = time_scale(d, p.y0_m) / step_for(d, p.y0_m);
+  if (!(fall_steps <= static_cast<double>(kMaxSteps)))
+    throw_input(where, keys, "",
+                fmt::format("the Schiller-Naumann cross-check would need {:.3g} integration steps for the fall "
+                            "(fall time {:.3g} s, relaxation time beta = {:.3g} s)",
+                            fall_steps, time_scale(d, p.y0_m), beta),
+                fmt::format("a drop test whose fall needs at most {:g} steps (fall time / beta <= 5e6)",
+                            static_cast<double>(kMaxSteps)));
+  try {
     const double vi = fall_speed_numeric(d, p.y0_m);
     double lo = 0.0, hi = std::sqrt(2.0 * g * p.y1_m);
     while (rise_height_numeric(d, hi) < p.y1_m) hi *= 2.0;
@@ -176,7 +214,16 @@ DropTestResult drop_test_restitution(const DropTestParams& p) {
       else hi = mid;
     }
     r.restitution_schiller_naumann = 0.5 * (lo + hi) / vi;
+  } catch (const IntegrationLimit& e) {
+    throw_input(where, keys, "",
+                fmt::format("the Schiller-Naumann cross-check cannot be integrated ({}; Reynolds number at impact {:.3g})",
+                            e.what(), r.reynolds_at_impact),
+                "a drop test the explicit integration can follow (a smaller Reynolds number: lower --air-density, "
+                "higher --viscosity or a shorter fall)");
   }
+  if (!std::isfinite(r.restitution_schiller_naumann))
+    throw_input(where, keys, "", "the Schiller-Naumann cross-check gives no finite restitution",
+                "a drop test the explicit integration can follow");
   return r;
 }
 

@@ -19,6 +19,8 @@
 // are reported.
 #pragma once
 
+#include <stdexcept>
+
 #include "nipdem/core/constants.hpp"
 
 namespace nipdem::calibrate {
@@ -57,6 +59,11 @@ struct DropTestResult {
 struct DragModel {
   double mass_kg, radius_m, viscosity_Pa_s, air_density_kg_per_m3, gravity_m_per_s2;
   bool schiller_naumann = false;
+};
+// Both throw IntegrationLimit (a std::runtime_error) when the explicit integration cannot follow
+// the drag (speed too high for the step) or needs more than 1e8 steps.
+struct IntegrationLimit : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 double fall_speed_numeric(const DragModel& d, double y0_m);
 double rise_height_numeric(const DragModel& d, double v_up_m_per_s);
