@@ -13,6 +13,7 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/nip/nip_config.hpp"
 #include "nipdem/nip/presets.hpp"
+#include "nipdem/experiments/calibrate_rc.hpp"
 #include "nipdem/experiments/edge_sharpness.hpp"
 #include "nipdem/experiments/front_position.hpp"
 #include "nipdem/experiments/reduction.hpp"
@@ -135,19 +136,11 @@ std::string rc_response(double R, double Rd, double C, double Rm, double voltage
   p.Rd_ohm = Rd;
   p.C_F = C;
   p.Rm_ohm = Rm;
-  p.validate();
-  require_range("rc response", "--R", p.R_ohm, 1e-3, 1e30);
-  require_range("rc response", "--Rd", p.Rd_ohm, 1e-3, 1e40);
-  require_range("rc response", "--C", p.C_F, 1e-24, 1.0);
-  require_range("rc response", "--voltage", voltage, -1e6, 1e6);
-  const auto fs = probe::parse_frequency_range(freq);
+  // the checks and the table of `nipdem rc response` (apps/cli/cmd_rc.cpp)
+  const auto table = probe::rc_response_table(p, voltage, freq);
   json rows = json::array();
-  for (double f : fs) {
-    const auto r = probe::response(p, voltage, f);
-    if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))
-      throw_input("rc response", "--R, --Rd, --C, --voltage", fmt::format("at {:g} Hz", f), "the response is not computable for these inputs");
-    rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
-  }
+  for (const auto& r : table)
+    rows.push_back({{"frequency_Hz", r.frequency_Hz}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
   json j;
   j["rows"] = rows;
   j["R_ohm"] = p.R_ohm;
