@@ -23,47 +23,8 @@
 namespace {
 using namespace nipdem;
 
-// The magnet's material (closed polygons, [m]) holds no toner: the field there is the one inside a
-// magnet, and on the blocks' corners the analytic field is singular (log; NaN exactly on one). A
-// point on or inside a block is refused, naming the options that placed it; `top` is the highest
-// point of the material (below it a point may be outside the blocks too, above it always is).
-bool on_or_in(Vec2 p, const std::vector<Vec2>& v) {
-  bool in = false;
-  for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
-    const Vec2 a = v[j], b = v[i], ab = b - a, ap = p - a;
-    const double len2 = norm2(ab);
-    const double t = len2 > 0 ? std::clamp(dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
-    if (norm(ap - t * ab) <= 1e-12 * std::sqrt(len2)) return true;  // on the edge (round-off of its length)
-    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * ab.x / ab.y) in = !in;
-  }
-  return in;
-}
-struct Material {
-  std::vector<std::vector<Vec2>> blocks;
-  double top = -std::numeric_limits<double>::infinity();
-  explicit Material(const magnet::MagnetField& f) : blocks(f.material()) {
-    for (const auto& poly : blocks)
-      for (const Vec2& v : poly) top = std::max(top, v.y);
-  }
-  void require_outside(Vec2 p, const std::string& where, const std::string& keys, const std::string& allowed_prefix) const {
-    for (std::size_t k = 0; k < blocks.size(); ++k)
-      if (on_or_in(p, blocks[k]))
-        throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
-                    fmt::format("the point lies on or inside the magnet (block {} of {}): the field there is not one a toner "
-                                "can feel, and it is singular on the blocks' corners",
-                                k + 1, blocks.size()),
-                    fmt::format("{} outside the magnet's blocks, e.g. y > {:g} m (their top)", allowed_prefix, top));
-  }
-};
-// Backstop for what the material test cannot see (a point next to a corner, a map with a tiny
-// spacing): every value printed must be finite.
-void require_finite(const std::vector<double>& values, Vec2 p, const std::string& where, const std::string& keys,
-                    const std::string& allowed) {
-  for (double v : values)
-    if (!std::isfinite(v))
-      throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
-                  "the field or the force is not finite there (a magnet corner or edge, where the field is singular)", allowed);
-}
+using nip::MagnetMaterial;
+using nip::require_finite;
 
 // The magnet, toner and radius options of probe and line (nip/presets.hpp), and --json.
 struct Common {
@@ -106,18 +67,9 @@ nipdem::cli::Register reg([](CLI::App& app) {
   probe->add_option("--x", po->x, "x [m] along the process direction, 0 at the magnet edge")->required();
   probe->add_option("--y", po->y, "y [m] above the imaging-roller surface")->required();
   probe->callback([po] {
-    const std::string keys = "--x, --y";
-    require_range("field probe", "--x", po->x, -1.0, 1.0);
-    require_range("field probe", "--y", po->y, -1.0, 1.0);
-    if (po->c.field.map.empty()) {  // an analytic magnet knows its material (a map does not)
-      nip::check_field_options(po->c.field, "field probe");
-      Material(*nip::make_field_setup(po->c.field).field).require_outside({po->x, po->y}, "field probe", keys, "a point");
-    }
+    // The checks (a point on or inside the magnet, a value that is not finite) and the values
+    // are those of Python's nipdem.field_probe (one library function).
     const nlohmann::json j = nip::field_probe(po->c.field, po->x, po->y);
-    std::vector<double> values;
-    for (const auto& [k, v] : j.items())
-      if (v.is_number()) values.push_back(v.get<double>());
-    require_finite(values, {po->x, po->y}, "field probe", keys, "a point off the magnet's corners and edges");
     if (po->c.json) {
       cli::print_json(j.dump());
     } else {
@@ -189,7 +141,7 @@ nipdem::cli::Register reg([](CLI::App& app) {
     nip::check_field_options(lo->c.field, "field line");
     const nip::FieldSetup s = nip::make_field_setup(lo->c.field);
     const std::string keys = "--y, --x0, --x1, --n";
-    const Material material(*s.field);
+    const MagnetMaterial material(*s.field);
     std::vector<std::vector<double>> rows;
     std::vector<double> crossings;
     double prev_fx = 0, prev_x = 0, fmax = 0;

@@ -36,46 +36,11 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
     using namespace nipdem;
-    // Physical ranges (far beyond toner's: m ~ 4e-11 A m^2, d ~ 13 um), so no result overflows;
-    // checked here so that a message names the option (pigment_study names its fields).
-    if (!(o->moment > 0.0 && o->moment <= 1e-3))
-      throw_input("force dipole", "--moment", fmt::format("{:g}", o->moment),
-                  "out of range (the moment's size: its direction is --angle)", "(0, 0.001] A m^2");
-    require_range("force dipole", "--distance", o->distance, 1e-9, 1.0);
-    require_range("force dipole", "--radius", o->radius, 1e-9, 1e-2);
-    if (!(o->distance > 2.0 * o->radius))
-      throw_input("force dipole", "--distance", fmt::format("{:g}", o->distance),
-                  fmt::format("the spheres would overlap (--radius {:g})", o->radius), "> 2 x --radius");
-    require_range("force dipole", "--angle", o->angle_deg, -5e4, 5e4);
-    if (o->pigments < 1 || o->pigments > 1000000)
-      throw_input("force dipole", "--pigments", fmt::format("{}", o->pigments), "out of range", "[1, 1000000]");
-    // --samples is validated even with --pigments 1 (one placement; the JSON reports samples = 1).
-    if (o->samples < 1 || o->samples > 10000000)
-      throw_input("force dipole", "--samples", fmt::format("{}", o->samples), "out of range", "[1, 1e7]");
-    // The cost is pigments^2 x samples pair forces at ~1e8 per second (1000 pigments x 1000
-    // samples: 8 s), with no progress shown: more than kMaxPairs (~10 s) is refused.
-    constexpr double kMaxPairs = 1e9;
-    const double pairs = static_cast<double>(o->pigments) * o->pigments * (o->pigments == 1 ? 1 : o->samples);
-    if (pairs > kMaxPairs)
-      throw_input("force dipole", "--pigments, --samples", fmt::format("{}, {}", o->pigments, o->samples),
-                  fmt::format("{:g} pigment-pair forces (pigments^2 x samples) would take about {:.0f} s at ~1e8 per second", pairs,
-                              pairs / 1e8),
-                  fmt::format("pigments^2 x samples <= {:g} (about 10 s)", kMaxPairs));
-    dipole::PigmentStudyParams p;
-    p.moment_Am2 = o->moment;
-    p.distance_m = o->distance;
-    p.angle_rad = o->angle_deg * constants::pi / 180.0;
-    p.radius_m = o->radius;
-    p.pigments = o->pigments;
-    p.samples = o->samples;
-    p.seed = o->seed;
-    const auto r = dipole::pigment_study(p);
-    // Cherry-pit reference (eq. 2.4.39 with both moments at the centres), for comparison.
-    const Vec2 m{o->moment * std::cos(p.angle_rad), o->moment * std::sin(p.angle_rad)};
-    const double cherry = norm(dipole::dipole_force(m, m, {o->distance, 0.0}));
-    if (!std::isfinite(cherry) || !std::isfinite(r.force_mean_vec_abs_N))
-      throw_input("force dipole", "--moment, --distance", fmt::format("{:g} A m^2, {:g} m", o->moment, o->distance),
-                  "the force is not representable for these inputs");
+    // The checks and the computation are those of Python's nipdem.force_dipole (one library function).
+    const dipole::DipoleAnswer a =
+        dipole::force_dipole_query({o->moment, o->distance, o->angle_deg, o->radius, o->pigments, o->samples, o->seed});
+    const dipole::PigmentStudyResult& r = a.study;
+    const double cherry = a.cherry_pit_force_N;
     if (o->json) {
       nlohmann::json j{{"moment_Am2", o->moment},
                        {"distance_m", o->distance},

@@ -43,56 +43,39 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o, coef_opt, thick_opt, eps_opt] {
     using namespace nipdem::electric;
-    ElectricForceParams p;
-    p.model = parse_force_model(o->model, "force electric", "--model");
-    // An option that would have no effect is refused rather than silently ignored.
-    if (coef_opt->count() > 0 && p.model != ForceModel::approx)
-      nipdem::throw_input("force electric", "--approx-coefficient", fmt::format("{:g}", o->approx_coefficient),
-                          fmt::format("has no effect with --model {}", to_string(p.model)), "--approx-coefficient with --model approx");
-    for (const auto* opt : {thick_opt, eps_opt})
-      if (opt->count() > 0 && !o->layer)
-        nipdem::throw_input("force electric", opt->get_name(), opt->as<std::string>(), "has no effect without --dielectric-layer",
-                            opt->get_name() + " together with --dielectric-layer");
-    // Physical ranges (far beyond toner's: R ~ 5 um, l ~ 1 um, 40 V, a = 0.45, SiOx 600 nm with
-    // eps_r = 5), so that no result overflows into null (issue 21); named by option.
-    nipdem::require_range("force electric", "--radius", o->radius, 1e-9, 1e-2);
-    nipdem::require_range("force electric", "--gap", o->gap, 1e-12, 1.0);
-    nipdem::require_range("force electric", "--voltage", o->voltage, -1e6, 1e6);
-    nipdem::require_range("force electric", "--approx-coefficient", o->approx_coefficient, 1e-3, 100.0);
-    if (o->layer) {
-      nipdem::require_range("force electric", "--layer-thickness", o->layer_thickness, 0.0, 1e-2);
-      nipdem::require_range("force electric", "--layer-permittivity", o->layer_eps, 1.0, 1e5);
-    }
-    p.approx_coefficient = o->approx_coefficient;
-    p.validate();
-    const double d = o->layer ? effective_gap(o->gap, o->layer_thickness, o->layer_eps) : o->gap;
-    const double F = force(p, o->radius, o->voltage, d);
-    const double Fexact = force_exact(o->radius, o->voltage, d);
-    if (!std::isfinite(F) || !std::isfinite(Fexact))  // not reached within the ranges above
-      nipdem::throw_input("force electric", "--radius, --gap, --voltage, --approx-coefficient, --layer-thickness, --layer-permittivity",
-                          fmt::format("{:g} m, {:g} m, {:g} V, {:g}, {:g} m, {:g}", o->radius, o->gap, o->voltage,
-                                      o->approx_coefficient, o->layer_thickness, o->layer_eps),
-                          "the force is not representable for these inputs");
+    // The checks and the computation are those of Python's nipdem.force_electric (one library
+    // function); an option given where it has no effect is refused there.
+    ForceQuery q;
+    q.radius_m = o->radius;
+    q.voltage_V = o->voltage;
+    q.gap_m = o->gap;
+    q.model = o->model;
+    if (coef_opt->count() > 0) q.approx_coefficient = o->approx_coefficient;
+    q.dielectric_layer = o->layer;
+    if (thick_opt->count() > 0) q.layer_thickness_m = o->layer_thickness, q.layer_thickness_text = thick_opt->as<std::string>();
+    if (eps_opt->count() > 0) q.layer_permittivity = o->layer_eps, q.layer_permittivity_text = eps_opt->as<std::string>();
+    const ForceAnswer r = force_query(q);
+    const double F = r.force_N, Fexact = r.force_exact_N, d = r.effective_gap_m;
     if (o->json) {
       nlohmann::json j;
       j["force_N"] = F;
-      j["model"] = to_string(p.model);
+      j["model"] = to_string(r.params.model);
       j["radius_m"] = o->radius;
       j["voltage_V"] = o->voltage;
       j["gap_m"] = o->gap;
       j["effective_gap_m"] = d;
       j["gap_over_radius"] = d / o->radius;
       j["force_exact_N"] = Fexact;
-      j["force_small_gap_limit_N"] = force_small_gap_asymptote(o->radius, o->voltage, d, true);
-      j["capacitance_F"] = sphere_plane_capacitance(o->radius, d);
+      j["force_small_gap_limit_N"] = r.force_small_gap_limit_N;
+      j["capacitance_F"] = r.capacitance_F;
       nipdem::cli::print_json(j.dump());
     } else {
-      std::printf("model            %s\n", to_string(p.model));
+      std::printf("model            %s\n", to_string(r.params.model));
       std::printf("force            %.6e N\n", F);
       std::printf("force (exact)    %.6e N\n", Fexact);
       std::printf("effective gap    %.6e m\n", d);
       std::printf("gap / radius     %.6g\n", d / o->radius);
-      std::printf("capacitance      %.6e F\n", sphere_plane_capacitance(o->radius, d));
+      std::printf("capacitance      %.6e F\n", r.capacitance_F);
     }
   });
 });

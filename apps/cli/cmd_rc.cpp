@@ -17,23 +17,8 @@ namespace {
 
 nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-// Highest frequency of `rc response --freq` and of a `calibrate rc` data row (the probe is
-// measured at 500-2000 Hz; within these bounds no term of eq. 4.7.7 overflows).
-constexpr double kMaxFrequency_Hz = nipdem::probe::kMaxFrequency_Hz;
-
-// --voltage of rc response and calibrate rc: the amplitude V of the applied V sin(wt), so
-// positive. A negative V would be the same signal shifted by 180 deg; the phase is given
-// relative to the applied signal, so it would print exactly the results of |V|: refused
-// rather than silently treated as |V|.
-void check_amplitude(const std::string& where, double V) {
-  const std::string allowed = "[1e-06, 1e+06] V";
-  if (V < 0.0)
-    nipdem::throw_input(where, "--voltage", fmt::format("{:g}", V),
-                        "is the amplitude of the applied V sin(wt) and must be positive (a negative amplitude is the "
-                        "same signal shifted by 180 deg; give its magnitude)",
-                        allowed);
-  if (!(V >= 1e-6 && V <= 1e6)) nipdem::throw_input(where, "--voltage", fmt::format("{:g}", V), "out of range", allowed);
-}
+// --voltage of rc response and calibrate rc (experiments/calibrate_rc.hpp).
+using nipdem::probe::check_amplitude;
 
 struct ResponseOpts {
   nipdem::probe::ProbeCircuitParams p;
@@ -68,31 +53,15 @@ nipdem::cli::Register reg([](CLI::App& app) {
   sub->add_option("--freq", o->freq, "frequencies F1:F2:STEP [Hz]")->required();
   sub->add_flag("--json", o->json, "print one JSON object on stdout");
   sub->callback([o] {
-    // A value <= 0 is refused by validate (its message is the one Python's nipdem.rc_response
-    // gives, tests/python/test_functions.py); then physical ranges (the thesis' circuit: R ~ 1e6,
-    // Rd >= 1e24 ohm, C ~ 1e-12 F, Rm = 1e4 ohm, 40 V, 500-2000 Hz) with wide margins, so that no
-    // amplitude or phase overflows into null.
-    o->p.validate();
-    nipdem::require_range("rc response", "--R", o->p.R_ohm, 1e-3, 1e30);
-    nipdem::require_range("rc response", "--Rd", o->p.Rd_ohm, 1e-3, 1e40);
-    nipdem::require_range("rc response", "--C", o->p.C_F, 1e-24, 1.0);
-    nipdem::require_range("rc response", "--Rm", o->p.Rm_ohm, 1e-3, 1e30);
-    check_amplitude("rc response", o->voltage);
-    const auto fs = nipdem::probe::parse_frequency_range(o->freq);
-    if (fs.back() > kMaxFrequency_Hz)
-      nipdem::throw_input("rc response", "--freq", o->freq, fmt::format("frequencies above {:g} Hz", kMaxFrequency_Hz),
-                          fmt::format("F1:F2:STEP with 0 < F1 <= F2 <= {:g} Hz", kMaxFrequency_Hz));
+    // The checks and the table are those of Python's nipdem.rc_response (one library function).
+    const auto table = nipdem::probe::rc_response_table(o->p, o->voltage, o->freq);
     nlohmann::json rows = nlohmann::json::array();
     if (!o->json) std::printf("%14s %16s %12s\n", "frequency_Hz", "amplitude_V", "phase_deg");
-    for (double f : fs) {
-      const auto r = nipdem::probe::response(o->p, o->voltage, f);
-      if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))  // not reached within the ranges above
-        nipdem::throw_input("rc response", "--R, --Rd, --C, --Rm, --voltage, --freq", fmt::format("at {:g} Hz", f),
-                            "the response is not computable for these inputs");
+    for (const auto& r : table) {
       if (o->json) {
-        rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
+        rows.push_back({{"frequency_Hz", r.frequency_Hz}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
       } else {
-        std::printf("%14.6g %16.6e %12.6f\n", f, r.amplitude_V, r.phase_deg());
+        std::printf("%14.6g %16.6e %12.6f\n", r.frequency_Hz, r.amplitude_V, r.phase_deg());
       }
     }
     if (o->json) {

@@ -319,20 +319,19 @@ PYBIND11_MODULE(_nipdem, m) {
 
   // ---- the CLI's functions (JSON text; the package parses it)
   m.def("collision_params", &nipdem::python::collision_params, py::arg("text"), py::arg("file"), py::arg("overrides"));
-  {
-    const nipdem::python::ElectricArgs d;
-    m.def(
-        "force_electric",
-        [](double radius, double voltage, double gap, const std::string& model, double a, bool layer, double lt, double le) {
-          nipdem::python::ElectricArgs e;
-          e.radius = radius; e.voltage = voltage; e.gap = gap; e.model = model; e.approx_coefficient = a;
-          e.dielectric_layer = layer; e.layer_thickness = lt; e.layer_permittivity = le;
-          return nipdem::python::force_electric(e);
-        },
-        py::arg("radius"), py::arg("voltage"), py::arg("gap"), py::arg("model") = d.model,
-        py::arg("approx_coefficient") = d.approx_coefficient, py::arg("dielectric_layer") = false,
-        py::arg("layer_thickness") = d.layer_thickness, py::arg("layer_permittivity") = d.layer_permittivity);
-  }
+  // approx_coefficient, layer_thickness, layer_permittivity: None is "not given" (the CLI's
+  // default applies); a value given where it has no effect is refused, as by the CLI.
+  m.def(
+      "force_electric",
+      [](double radius, double voltage, double gap, const std::string& model, std::optional<double> a, bool layer,
+         std::optional<double> lt, std::optional<double> le) {
+        nipdem::python::ElectricArgs e;
+        e.radius_m = radius; e.voltage_V = voltage; e.gap_m = gap; e.model = model; e.approx_coefficient = a;
+        e.dielectric_layer = layer; e.layer_thickness_m = lt; e.layer_permittivity = le;
+        return nipdem::python::force_electric(e);
+      },
+      py::arg("radius"), py::arg("voltage"), py::arg("gap"), py::arg("model") = "exact", py::arg("approx_coefficient") = py::none(),
+      py::arg("dielectric_layer") = false, py::arg("layer_thickness") = py::none(), py::arg("layer_permittivity") = py::none());
   {
     const nipdem::python::DipoleArgs d;
     m.def(
@@ -342,7 +341,7 @@ PYBIND11_MODULE(_nipdem, m) {
           py::gil_scoped_release release;
           return nipdem::python::force_dipole(a);
         },
-        py::arg("moment"), py::arg("distance"), py::arg("angle"), py::arg("radius") = d.radius, py::arg("pigments") = d.pigments,
+        py::arg("moment"), py::arg("distance"), py::arg("angle"), py::arg("radius") = d.radius_m, py::arg("pigments") = d.pigments,
         py::arg("samples") = d.samples, py::arg("seed") = d.seed);
   }
   m.def(

@@ -13,6 +13,7 @@
 #include "nipdem/core/error.hpp"
 #include "nipdem/nip/nip_config.hpp"
 #include "nipdem/nip/presets.hpp"
+#include "nipdem/experiments/calibrate_rc.hpp"
 #include "nipdem/experiments/edge_sharpness.hpp"
 #include "nipdem/experiments/front_position.hpp"
 #include "nipdem/experiments/reduction.hpp"
@@ -34,71 +35,41 @@ std::string collision_params(const std::string& text, const std::string& file, c
   return nip::collision_json(nip::parse_nip_config(text, file, overrides)).dump();
 }
 
-ElectricArgs::ElectricArgs()
-    : approx_coefficient(electric::kThesisApproxCoefficient),
-      layer_thickness(electric::kSiOxThickness_m),
-      layer_permittivity(electric::kSiOxPermittivity) {}
-
 std::string force_electric(const ElectricArgs& a) {
-  using namespace electric;
-  ElectricForceParams p;
-  p.model = parse_force_model(a.model, "force electric", "--model");
-  p.approx_coefficient = a.approx_coefficient;
-  p.validate();
-  require_range("force electric", "--radius", a.radius, 1e-9, 1e-2);
-  require_range("force electric", "--gap", a.gap, 1e-12, 1.0);
-  require_range("force electric", "--voltage", a.voltage, -1e6, 1e6);
-  const double d = a.dielectric_layer ? effective_gap(a.gap, a.layer_thickness, a.layer_permittivity) : a.gap;
-  const double F = force(p, a.radius, a.voltage, d);
-  const double Fexact = force_exact(a.radius, a.voltage, d);
-  if (!std::isfinite(F) || !std::isfinite(Fexact))
-    throw_input("force electric", "--radius, --gap, --voltage", fmt::format("{:g} m, {:g} m, {:g} V", a.radius, a.gap, a.voltage),
-                "the force is not representable for these inputs");
+  // the checks and the computation of `nipdem force electric` (apps/cli/cmd_force_electric.cpp)
+  const electric::ForceAnswer r = electric::force_query(a);
   json j;
-  j["force_N"] = F;
-  j["model"] = to_string(p.model);
-  j["radius_m"] = a.radius;
-  j["voltage_V"] = a.voltage;
-  j["gap_m"] = a.gap;
-  j["effective_gap_m"] = d;
-  j["gap_over_radius"] = d / a.radius;
-  j["force_exact_N"] = Fexact;
-  j["force_small_gap_limit_N"] = force_small_gap_asymptote(a.radius, a.voltage, d, true);
-  j["capacitance_F"] = sphere_plane_capacitance(a.radius, d);
+  j["force_N"] = r.force_N;
+  j["model"] = to_string(r.params.model);
+  j["radius_m"] = a.radius_m;
+  j["voltage_V"] = a.voltage_V;
+  j["gap_m"] = a.gap_m;
+  j["effective_gap_m"] = r.effective_gap_m;
+  j["gap_over_radius"] = r.effective_gap_m / a.radius_m;
+  j["force_exact_N"] = r.force_exact_N;
+  j["force_small_gap_limit_N"] = r.force_small_gap_limit_N;
+  j["capacitance_F"] = r.capacitance_F;
   return j.dump();
 }
 
-std::string force_dipole(const DipoleArgs& a) {
-  require_range("force dipole", "--moment", a.moment, -1e-3, 1e-3);
-  require_range("force dipole", "--distance", a.distance, 1e-9, 1.0);
-  require_range("force dipole", "--radius", a.radius, 1e-9, 1e-2);
-  dipole::PigmentStudyParams p;
-  p.moment_Am2 = a.moment;
-  p.distance_m = a.distance;
-  p.angle_rad = a.angle_deg * constants::pi / 180.0;
-  p.radius_m = a.radius;
-  p.pigments = a.pigments;
-  p.samples = a.samples;
-  p.seed = a.seed;
-  const auto r = dipole::pigment_study(p);
-  const Vec2 m{a.moment * std::cos(p.angle_rad), a.moment * std::sin(p.angle_rad)};
-  const double cherry = norm(dipole::dipole_force(m, m, {a.distance, 0.0}));
-  if (!std::isfinite(cherry) || !std::isfinite(r.force_mean_vec_abs_N))
-    throw_input("force dipole", "--moment, --distance", fmt::format("{:g} A m^2, {:g} m", a.moment, a.distance),
-                "the force is not representable for these inputs");
-  json j{{"moment_Am2", a.moment},
-         {"distance_m", a.distance},
-         {"angle_deg", a.angle_deg},
-         {"radius_m", a.radius},
-         {"pigments", a.pigments},
+std::string force_dipole(const DipoleArgs& q) {
+  // the checks and the computation of `nipdem force dipole` (apps/cli/cmd_force_dipole.cpp)
+  const dipole::DipoleAnswer ans = dipole::force_dipole_query(q);
+  const dipole::PigmentStudyResult& r = ans.study;
+  const double cherry = ans.cherry_pit_force_N;
+  json j{{"moment_Am2", q.moment_Am2},
+         {"distance_m", q.distance_m},
+         {"angle_deg", q.angle_deg},
+         {"radius_m", q.radius_m},
+         {"pigments", q.pigments},
          {"samples", r.samples},
-         {"seed", a.seed},
+         {"seed", q.seed},
          {"force_N", r.force_mean_vec_abs_N},
          {"force_mean_abs_N", r.force_mean_abs_N},
          {"force_mean_vector_N", {r.force_mean_N.x, r.force_mean_N.y, r.force_mean_N.z}},
          {"force_mean_vector_abs_N", r.force_mean_vec_abs_N},
          {"cherry_pit_force_N", cherry}};
-  if (a.pigments > 1) {
+  if (q.pigments > 1) {
     j["force_std_N"] = r.force_std_N;
     j["force_vector_std_N"] = {r.force_vec_std_N.x, r.force_vec_std_N.y, r.force_vec_std_N.z};
     j["force_sem_N"] = std::hypot(r.force_vec_std_N.x, r.force_vec_std_N.y, r.force_vec_std_N.z) / std::sqrt(static_cast<double>(r.samples));
@@ -135,19 +106,11 @@ std::string rc_response(double R, double Rd, double C, double Rm, double voltage
   p.Rd_ohm = Rd;
   p.C_F = C;
   p.Rm_ohm = Rm;
-  p.validate();
-  require_range("rc response", "--R", p.R_ohm, 1e-3, 1e30);
-  require_range("rc response", "--Rd", p.Rd_ohm, 1e-3, 1e40);
-  require_range("rc response", "--C", p.C_F, 1e-24, 1.0);
-  require_range("rc response", "--voltage", voltage, -1e6, 1e6);
-  const auto fs = probe::parse_frequency_range(freq);
+  // the checks and the table of `nipdem rc response` (apps/cli/cmd_rc.cpp)
+  const auto table = probe::rc_response_table(p, voltage, freq);
   json rows = json::array();
-  for (double f : fs) {
-    const auto r = probe::response(p, voltage, f);
-    if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))
-      throw_input("rc response", "--R, --Rd, --C, --voltage", fmt::format("at {:g} Hz", f), "the response is not computable for these inputs");
-    rows.push_back({{"frequency_Hz", f}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
-  }
+  for (const auto& r : table)
+    rows.push_back({{"frequency_Hz", r.frequency_Hz}, {"amplitude_V", r.amplitude_V}, {"phase_deg", r.phase_deg()}});
   json j;
   j["rows"] = rows;
   j["R_ohm"] = p.R_ohm;

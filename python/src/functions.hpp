@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "nipdem/models/dipole_pigments.hpp"
+#include "nipdem/models/electric_force.hpp"
 #include "nipdem/nip/presets.hpp"
 
 namespace nipdem::python {
@@ -15,21 +17,10 @@ namespace nipdem::python {
 // `nipdem params collision` for the configuration `text` (named `file`) with `overrides`.
 std::string collision_params(const std::string& text, const std::string& file, const std::vector<std::string>& overrides);
 
-struct ElectricArgs {
-  double radius = 0, voltage = 0, gap = 0;
-  std::string model = "exact";
-  double approx_coefficient;  // defaults: the CLI's (set in the constructor)
-  bool dielectric_layer = false;
-  double layer_thickness, layer_permittivity;
-  ElectricArgs();
-};
+using ElectricArgs = electric::ForceQuery;  // the CLI's options: given or not
 std::string force_electric(const ElectricArgs& a);  // `nipdem force electric`
 
-struct DipoleArgs {
-  double moment = 3.7e-11, distance = 13e-6, angle_deg = 0.0, radius = 6e-6;
-  int pigments = 1, samples = 1000;
-  std::uint64_t seed = 1;
-};
+using DipoleArgs = dipole::DipoleQuery;  // moment, distance, angle [deg], radius, pigments, samples, seed
 std::string force_dipole(const DipoleArgs& a);  // `nipdem force dipole`
 
 using FieldArgs = nip::FieldOptions;  // the CLI's options: given or not

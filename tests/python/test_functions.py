@@ -85,3 +85,51 @@ def test_invalid_input_raises_the_cli_message(call, args):
     status, _, err = cli(*args, "--json", check=False)
     assert status == 2
     assert str(e.value) in err, (str(e.value), err)
+
+
+# Values the CLI refuses (tests/hostile/test_hostile_rc.cpp, test_hostile_field.cpp) that the
+# Python functions used to accept with a result (their checks were an older copy of the CLI's):
+# now both call one library check each and give the same message.
+_RC = (5.9e11, 1.8e24, 3.9e-16)
+_RC_CLI = ["rc", "response", "--R", "5.9e11", "--Rd", "1.8e24", "--C", "3.9e-16"]
+_EL_CLI = ["force", "electric", "--radius", "5e-06", "--gap", "1e-06"]
+_DI_CLI = ["force", "dipole", "--distance", "1.3e-05"]
+
+
+@pytest.mark.parametrize("call,args", [
+    # rc response: a negative amplitude, Rm beyond its range, frequencies above the bound
+    (lambda: nipdem.rc_response(*_RC, -1, "100:200:100"), [*_RC_CLI, "--voltage", "-1", "--freq", "100:200:100"]),
+    (lambda: nipdem.rc_response(*_RC, 0, "100:200:100"), [*_RC_CLI, "--voltage", "0", "--freq", "100:200:100"]),
+    (lambda: nipdem.rc_response(*_RC, 1, "100:200:100", Rm=1e308),
+     [*_RC_CLI, "--voltage", "1", "--freq", "100:200:100", "--Rm", "1e+308"]),
+    (lambda: nipdem.rc_response(*_RC, 1, "1e13:1e13:1"), [*_RC_CLI, "--voltage", "1", "--freq", "1e13:1e13:1"]),
+    # force electric: options without effect, an approx coefficient / layer out of range
+    (lambda: nipdem.force_electric(5e-6, 40, 1e-6, approx_coefficient=0.5),
+     [*_EL_CLI, "--voltage", "40", "--approx-coefficient", "0.5"]),
+    (lambda: nipdem.force_electric(5e-6, 40, 1e-6, layer_thickness=2e-06),
+     [*_EL_CLI, "--voltage", "40", "--layer-thickness", "2e-06"]),
+    (lambda: nipdem.force_electric(5e-6, 40, 1e-6, layer_permittivity=5),
+     [*_EL_CLI, "--voltage", "40", "--layer-permittivity", "5"]),
+    (lambda: nipdem.force_electric(5e-6, 40, 1e-6, model="approx", approx_coefficient=1e308),
+     [*_EL_CLI, "--voltage", "40", "--model", "approx", "--approx-coefficient", "1e+308"]),
+    (lambda: nipdem.force_electric(5e-6, 40, 1e-6, dielectric_layer=True, layer_permittivity=0.5),
+     [*_EL_CLI, "--voltage", "40", "--dielectric-layer", "--layer-permittivity", "0.5"]),
+    # force dipole: a negative moment, overlapping spheres, an absurd angle, samples < 1
+    (lambda: nipdem.force_dipole(-3.7e-11, 13e-6, 0), [*_DI_CLI, "--moment", "-3.7e-11", "--angle", "0"]),
+    (lambda: nipdem.force_dipole(3.7e-11, 10e-6, 0), ["force", "dipole", "--moment", "3.7e-11", "--distance", "1e-05",
+                                                      "--angle", "0"]),
+    (lambda: nipdem.force_dipole(3.7e-11, 13e-6, 1e308), [*_DI_CLI, "--moment", "3.7e-11", "--angle", "1e+308"]),
+    (lambda: nipdem.force_dipole(3.7e-11, 13e-6, 0, samples=0),
+     [*_DI_CLI, "--moment", "3.7e-11", "--angle", "0", "--samples", "0"]),
+    # field probe: the knife edge (a corner of the magnet: NaN) and points inside its blocks
+    (lambda: nipdem.field_probe(0, -1e-4), ["field", "probe", "--x", "0", "--y", "-0.0001"]),
+    (lambda: nipdem.field_probe(-3e-4, -1e-4, preset="color"),
+     ["field", "probe", "--preset", "color", "--x", "-0.0003", "--y", "-0.0001"]),
+    (lambda: nipdem.field_probe(0, -5e-5, tip_depth=5e-5), ["field", "probe", "--tip-depth", "5e-05", "--x", "0", "--y", "-5e-05"]),
+])
+def test_python_refuses_what_the_cli_refuses(call, args):
+    with pytest.raises(ValueError) as e:
+        call()
+    status, out, err = cli(*args, "--json", check=False)
+    assert status == 2 and out == ""
+    assert str(e.value) in err, (str(e.value), err)

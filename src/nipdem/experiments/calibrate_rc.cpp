@@ -312,4 +312,40 @@ RcFitResult fit_rc(const std::vector<RcDataPoint>& data, const RcFitOptions& opt
   return res;
 }
 
+void check_amplitude(const std::string& where, double V) {
+  const std::string allowed = "[1e-06, 1e+06] V";
+  if (V < 0.0)
+    throw_input(where, "--voltage", fmt::format("{:g}", V),
+                "is the amplitude of the applied V sin(wt) and must be positive (a negative amplitude is the "
+                "same signal shifted by 180 deg; give its magnitude)",
+                allowed);
+  if (!(V >= 1e-6 && V <= 1e6)) throw_input(where, "--voltage", fmt::format("{:g}", V), "out of range", allowed);
+}
+
+std::vector<ProbeResponse> rc_response_table(const ProbeCircuitParams& p, double voltage_V, const std::string& freq) {
+  // A value <= 0 is refused by validate (its message names the circuit's key); then physical
+  // ranges (the thesis' circuit: R ~ 1e6, Rd >= 1e24 ohm, C ~ 1e-12 F, Rm = 1e4 ohm, 40 V,
+  // 500-2000 Hz) with wide margins, so that no amplitude or phase overflows into null.
+  p.validate();
+  require_range("rc response", "--R", p.R_ohm, 1e-3, 1e30);
+  require_range("rc response", "--Rd", p.Rd_ohm, 1e-3, 1e40);
+  require_range("rc response", "--C", p.C_F, 1e-24, 1.0);
+  require_range("rc response", "--Rm", p.Rm_ohm, 1e-3, 1e30);
+  check_amplitude("rc response", voltage_V);
+  const auto fs = parse_frequency_range(freq);
+  if (fs.back() > kMaxFrequency_Hz)
+    throw_input("rc response", "--freq", freq, fmt::format("frequencies above {:g} Hz", kMaxFrequency_Hz),
+                fmt::format("F1:F2:STEP with 0 < F1 <= F2 <= {:g} Hz", kMaxFrequency_Hz));
+  std::vector<ProbeResponse> rows;
+  rows.reserve(fs.size());
+  for (double f : fs) {
+    rows.push_back(response(p, voltage_V, f));
+    const ProbeResponse& r = rows.back();
+    if (!std::isfinite(r.amplitude_V) || !std::isfinite(r.phase_deg()))  // not reached within the ranges above
+      throw_input("rc response", "--R, --Rd, --C, --Rm, --voltage, --freq", fmt::format("at {:g} Hz", f),
+                  "the response is not computable for these inputs");
+  }
+  return rows;
+}
+
 }  // namespace nipdem::probe

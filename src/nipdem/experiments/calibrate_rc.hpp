@@ -26,6 +26,20 @@ namespace nipdem::probe {
 // 500-2000 Hz; below this bound no term of eq. 4.7.7 overflows for any circuit in the search box.
 inline constexpr double kMaxFrequency_Hz = 1e12;
 
+// --voltage of `rc response` and `calibrate rc` (`where`): the amplitude V of the applied
+// V sin(wt), in [1e-6, 1e6] V. A negative V would be the same signal shifted by 180 deg; the
+// phase is given relative to the applied signal, so it would give exactly the results of |V|:
+// refused (InputError naming --voltage) rather than silently treated as |V|.
+void check_amplitude(const std::string& where, double V);
+
+// `rc response` -- the one check and computation of the CLI command and of Python's
+// nipdem.rc_response: checks the circuit (ProbeCircuitParams::validate, then --R in [1e-3, 1e30],
+// --Rd in [1e-3, 1e40], --C in [1e-24, 1], --Rm in [1e-3, 1e30]), the amplitude
+// (check_amplitude) and the frequencies "F1:F2:STEP" (parse_frequency_range, F2 <=
+// kMaxFrequency_Hz), throwing InputError naming `rc response` and the option; then solves
+// eq. 4.7.7 at each frequency (every amplitude and phase finite).
+std::vector<ProbeResponse> rc_response_table(const ProbeCircuitParams& p, double voltage_V, const std::string& freq);
+
 struct RcDataPoint {
   double frequency_Hz = 0.0;
   double amplitude_V = 0.0;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <vector>
 
+#include "nipdem/core/constants.hpp"
 #include "nipdem/core/error.hpp"
 #include "nipdem/core/rng.hpp"
 
@@ -78,6 +79,50 @@ PigmentStudyResult pigment_study(const PigmentStudyParams& p) {
   r.force_mean_vec_abs_N = std::sqrt(vx * vx + vy * vy + vz * vz) / N;
   r.force_vec_std_N = {sd(vx, vx2), sd(vy, vy2), sd(vz, vz2)};
   return r;
+}
+
+DipoleAnswer force_dipole_query(const DipoleQuery& q) {
+  const std::string w = "force dipole";
+  // Physical ranges (far beyond toner's: m ~ 4e-11 A m^2, d ~ 13 um), so no result overflows;
+  // named by option (pigment_study names its fields).
+  if (!(q.moment_Am2 > 0.0 && q.moment_Am2 <= 1e-3))
+    throw_input(w, "--moment", fmt::format("{:g}", q.moment_Am2), "out of range (the moment's size: its direction is --angle)",
+                "(0, 0.001] A m^2");
+  require_range(w, "--distance", q.distance_m, 1e-9, 1.0);
+  require_range(w, "--radius", q.radius_m, 1e-9, 1e-2);
+  if (!(q.distance_m > 2.0 * q.radius_m))
+    throw_input(w, "--distance", fmt::format("{:g}", q.distance_m), fmt::format("the spheres would overlap (--radius {:g})", q.radius_m),
+                "> 2 x --radius");
+  require_range(w, "--angle", q.angle_deg, -5e4, 5e4);
+  if (q.pigments < 1 || q.pigments > 1000000) throw_input(w, "--pigments", fmt::format("{}", q.pigments), "out of range", "[1, 1000000]");
+  // --samples is validated even with --pigments 1 (one placement; the result reports samples = 1).
+  if (q.samples < 1 || q.samples > 10000000) throw_input(w, "--samples", fmt::format("{}", q.samples), "out of range", "[1, 1e7]");
+  // The cost is pigments^2 x samples pair forces at ~1e8 per second (1000 pigments x 1000
+  // samples: 8 s), with no progress shown: more than kMaxPairs (~10 s) is refused.
+  constexpr double kMaxPairs = 1e9;
+  const double pairs = static_cast<double>(q.pigments) * q.pigments * (q.pigments == 1 ? 1 : q.samples);
+  if (pairs > kMaxPairs)
+    throw_input(w, "--pigments, --samples", fmt::format("{}, {}", q.pigments, q.samples),
+                fmt::format("{:g} pigment-pair forces (pigments^2 x samples) would take about {:.0f} s at ~1e8 per second", pairs,
+                            pairs / 1e8),
+                fmt::format("pigments^2 x samples <= {:g} (about 10 s)", kMaxPairs));
+  PigmentStudyParams p;
+  p.moment_Am2 = q.moment_Am2;
+  p.distance_m = q.distance_m;
+  p.angle_rad = q.angle_deg * constants::pi / 180.0;
+  p.radius_m = q.radius_m;
+  p.pigments = q.pigments;
+  p.samples = q.samples;
+  p.seed = q.seed;
+  DipoleAnswer a;
+  a.study = pigment_study(p);
+  // Cherry-pit reference (eq. 2.4.39 with both moments at the centres), for comparison.
+  const Vec2 m{q.moment_Am2 * std::cos(p.angle_rad), q.moment_Am2 * std::sin(p.angle_rad)};
+  a.cherry_pit_force_N = norm(dipole_force(m, m, {q.distance_m, 0.0}));
+  if (!std::isfinite(a.cherry_pit_force_N) || !std::isfinite(a.study.force_mean_vec_abs_N))
+    throw_input(w, "--moment, --distance", fmt::format("{:g} A m^2, {:g} m", q.moment_Am2, q.distance_m),
+                "the force is not representable for these inputs");
+  return a;
 }
 
 }  // namespace nipdem::dipole

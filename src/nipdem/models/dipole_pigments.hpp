@@ -40,4 +40,25 @@ struct PigmentStudyResult {
 // Throws InputError for d <= 2R, non-positive m or R, n < 1 or n > 1e6, samples < 1, n^2*samples > 1e11.
 PigmentStudyResult pigment_study(const PigmentStudyParams& p);
 
+// `force dipole` -- the one check and computation of the CLI command and of Python's
+// nipdem.force_dipole (fields in the order of their arguments).
+struct DipoleQuery {
+  double moment_Am2 = 3.7e-11;  // the moment's size [A m^2]; its direction is angle_deg
+  double distance_m = 13e-6;    // centre distance [m]
+  double angle_deg = 0.0;       // field angle to the line of centres [deg]
+  double radius_m = 6e-6;       // toner radius [m]
+  int pigments = 1, samples = 1000;
+  std::uint64_t seed = 1;
+};
+struct DipoleAnswer {
+  PigmentStudyResult study;
+  double cherry_pit_force_N = 0;  // eq. 2.4.39 with both moments at the centres, for comparison
+};
+// Checks (InputError naming `force dipole` and the option: --moment in (0, 1e-3] A m^2,
+// --distance in [1e-9, 1] m, --radius in [1e-9, 1e-2] m, --distance > 2 x --radius, --angle in
+// [-5e4, 5e4] deg, --pigments in [1, 1e6], --samples in [1, 1e7] (also with one pigment),
+// pigments^2 x samples <= 1e9 (about 10 s)), then runs pigment_study; a force that is not
+// finite is refused too.
+DipoleAnswer force_dipole_query(const DipoleQuery& q);
+
 }  // namespace nipdem::dipole

@@ -209,4 +209,48 @@ double ElectricForceTable::force(double R, double V, double d) const {
   return constants::eps0 * V * V * dimensionless(d / R);
 }
 
+ForceAnswer force_query(const ForceQuery& q) {
+  const std::string w = "force electric";
+  ForceAnswer a;
+  a.params.model = parse_force_model(q.model, w, "--model");
+  const double coef = q.approx_coefficient.value_or(kThesisApproxCoefficient);
+  a.layer_thickness_m = q.layer_thickness_m.value_or(kSiOxThickness_m);
+  a.layer_permittivity = q.layer_permittivity.value_or(kSiOxPermittivity);
+  // An option that would have no effect is refused rather than silently ignored.
+  if (q.approx_coefficient && a.params.model != ForceModel::approx)
+    throw_input(w, "--approx-coefficient", fmt::format("{:g}", coef), fmt::format("has no effect with --model {}", to_string(a.params.model)),
+                "--approx-coefficient with --model approx");
+  const auto no_layer = [&](const char* key, const std::optional<double>& v, const std::string& text) {
+    if (v && !q.dielectric_layer)
+      throw_input(w, key, text.empty() ? fmt::format("{:g}", *v) : text, "has no effect without --dielectric-layer",
+                  std::string(key) + " together with --dielectric-layer");
+  };
+  no_layer("--layer-thickness", q.layer_thickness_m, q.layer_thickness_text);
+  no_layer("--layer-permittivity", q.layer_permittivity, q.layer_permittivity_text);
+  // Physical ranges (far beyond toner's: R ~ 5 um, l ~ 1 um, 40 V, a = 0.45, SiOx 600 nm with
+  // eps_r = 5), so that no result overflows into null (issue 21); named by option.
+  require_range(w, "--radius", q.radius_m, 1e-9, 1e-2);
+  require_range(w, "--gap", q.gap_m, 1e-12, 1.0);
+  require_range(w, "--voltage", q.voltage_V, -1e6, 1e6);
+  require_range(w, "--approx-coefficient", coef, 1e-3, 100.0);
+  if (q.dielectric_layer) {
+    require_range(w, "--layer-thickness", a.layer_thickness_m, 0.0, 1e-2);
+    require_range(w, "--layer-permittivity", a.layer_permittivity, 1.0, 1e5);
+  }
+  a.params.approx_coefficient = coef;
+  a.params.validate();
+  const double R = q.radius_m, V = q.voltage_V;
+  const double d = q.dielectric_layer ? effective_gap(q.gap_m, a.layer_thickness_m, a.layer_permittivity) : q.gap_m;
+  a.effective_gap_m = d;
+  a.force_N = force(a.params, R, V, d);
+  a.force_exact_N = force_exact(R, V, d);
+  if (!std::isfinite(a.force_N) || !std::isfinite(a.force_exact_N))  // not reached within the ranges above
+    throw_input(w, "--radius, --gap, --voltage, --approx-coefficient, --layer-thickness, --layer-permittivity",
+                fmt::format("{:g} m, {:g} m, {:g} V, {:g}, {:g} m, {:g}", R, q.gap_m, V, coef, a.layer_thickness_m, a.layer_permittivity),
+                "the force is not representable for these inputs");
+  a.force_small_gap_limit_N = force_small_gap_asymptote(R, V, d, true);
+  a.capacitance_F = sphere_plane_capacitance(R, d);
+  return a;
+}
+
 }  // namespace nipdem::electric

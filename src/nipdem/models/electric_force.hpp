@@ -19,6 +19,7 @@
 //            corrected form is F = -2 pi eps0 V^2 (F2 + F3). See docs/electric.md.
 //  - approx: eq. 2.5.42, F = a 4 pi eps0 R V^2 / d with a = 0.45 (thesis).
 #pragma once
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,36 @@ double force_small_gap_asymptote(double R, double V, double d, bool leading_only
 // Large-gap limit (d >> R): sphere charge q = 4 pi eps0 R V and its image,
 // F = pi eps0 R^2 V^2 / D^2 (1 + R/D), D = R + d the centre–plate distance.
 double force_large_gap_asymptote(double R, double V, double d);
+
+// `force electric` -- the one check and computation of the CLI command and of Python's
+// nipdem.force_electric. An empty optional is an option not given (its default applies); one
+// given where it has no effect is refused, never ignored.
+struct ForceQuery {
+  double radius_m = 0, voltage_V = 0, gap_m = 0;
+  std::string model = "exact";
+  std::optional<double> approx_coefficient;  // [-], default kThesisApproxCoefficient; only with model approx
+  bool dielectric_layer = false;             // gap_m is the distance l to the coated drum (eq. 2.5.43)
+  std::optional<double> layer_thickness_m;   // [m], default kSiOxThickness_m; only with dielectric_layer
+  std::optional<double> layer_permittivity;  // [-], default kSiOxPermittivity; only with dielectric_layer
+  // --layer-thickness / --layer-permittivity as the user typed them, quoted by the "no effect"
+  // message (the CLI's); empty: the value's {:g}.
+  std::string layer_thickness_text, layer_permittivity_text;
+};
+struct ForceAnswer {
+  ElectricForceParams params;
+  double layer_thickness_m = 0, layer_permittivity = 0;  // as used (the defaults where not given)
+  double effective_gap_m = 0;       // gap_m, or eq. 2.5.43 with the layer
+  double force_N = 0;               // the model's
+  double force_exact_N = 0;
+  double force_small_gap_limit_N = 0;  // leading term
+  double capacitance_F = 0;
+};
+// Checks (InputError naming `force electric` and the option: --model; --approx-coefficient,
+// --layer-thickness, --layer-permittivity without effect; --radius in [1e-9, 1e-2] m, --gap in
+// [1e-12, 1] m, --voltage in [-1e6, 1e6] V, --approx-coefficient in [1e-3, 100], with the layer
+// --layer-thickness in [0, 1e-2] m and --layer-permittivity in [1, 1e5]), then computes; a
+// result that is not finite is refused too.
+ForceAnswer force_query(const ForceQuery& q);
 
 // Tabulated exact force for the engine's inner loop: F = eps0 V^2 f(d/R) with log f
 // interpolated by cubic Hermite in log(d/R) on [x_min, x_max]; outside the table range

@@ -1,5 +1,11 @@
 #include "nipdem/nip/presets.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
 #include "nipdem/core/error.hpp"
 #include "nipdem/embedded_preset_black.hpp"
 #include "nipdem/embedded_preset_color.hpp"
@@ -58,19 +64,64 @@ FieldSetup make_field_setup(const FieldOptions& o) {
   return s;
 }
 
+namespace {
+// A point on an edge (within round-off of its length) or inside the closed polygon `v`.
+bool on_or_in(Vec2 p, const std::vector<Vec2>& v) {
+  bool in = false;
+  for (std::size_t i = 0, j = v.size() - 1; i < v.size(); j = i++) {
+    const Vec2 a = v[j], b = v[i], ab = b - a, ap = p - a;
+    const double len2 = norm2(ab);
+    const double t = len2 > 0 ? std::clamp(dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
+    if (norm(ap - t * ab) <= 1e-12 * std::sqrt(len2)) return true;  // on the edge (round-off of its length)
+    if ((a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) * ab.x / ab.y) in = !in;
+  }
+  return in;
+}
+}  // namespace
+
+MagnetMaterial::MagnetMaterial(const magnet::MagnetField& f) : blocks_(f.material()), top_(-std::numeric_limits<double>::infinity()) {
+  for (const auto& poly : blocks_)
+    for (const Vec2& v : poly) top_ = std::max(top_, v.y);
+}
+
+void MagnetMaterial::require_outside(Vec2 p, const std::string& where, const std::string& keys, const std::string& allowed_prefix) const {
+  for (std::size_t k = 0; k < blocks_.size(); ++k)
+    if (on_or_in(p, blocks_[k]))
+      throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
+                  fmt::format("the point lies on or inside the magnet (block {} of {}): the field there is not one a toner "
+                              "can feel, and it is singular on the blocks' corners",
+                              k + 1, blocks_.size()),
+                  fmt::format("{} outside the magnet's blocks, e.g. y > {:g} m (their top)", allowed_prefix, top_));
+}
+
+void require_finite(const std::vector<double>& values, Vec2 p, const std::string& where, const std::string& keys,
+                    const std::string& allowed) {
+  for (double v : values)
+    if (!std::isfinite(v))
+      throw_input(where, keys, fmt::format("point ({:g}, {:g}) m", p.x, p.y),
+                  "the field or the force is not finite there (a magnet corner or edge, where the field is singular)", allowed);
+}
+
 nlohmann::json field_probe(const FieldOptions& o, double x, double y) {
   require_range("field probe", "--x", x, -1.0, 1.0);
   require_range("field probe", "--y", y, -1.0, 1.0);
   check_field_options(o, "field probe");
   const FieldSetup s = make_field_setup(o);
+  const std::string keys = "--x, --y";
+  MagnetMaterial(*s.field).require_outside({x, y}, "field probe", keys, "a point");  // an analytic magnet's (a map has none)
   const auto smp = s.field->at({x, y});
   const Vec2 m = magnet::induced_moment(s.toner, s.radius_m, smp.B);
   const Vec2 F = magnet::dipole_force(m, smp);
-  return {{"preset", o.preset},         {"source", s.field->describe()}, {"x_m", x},
+  nlohmann::json j = {{"preset", o.preset},         {"source", s.field->describe()}, {"x_m", x},
           {"y_m", y},                   {"Bx_T", smp.B.x},                {"By_T", smp.B.y},
           {"B_T", norm(smp.B)},         {"dBx_dx_T_per_m", smp.dB.xx},    {"dBx_dy_T_per_m", smp.dB.xy},
           {"dBy_dx_T_per_m", smp.dB.yx}, {"dBy_dy_T_per_m", smp.dB.yy},   {"radius_m", s.radius_m},
           {"mx_Am2", m.x},              {"my_Am2", m.y},                  {"moment_Am2", norm(m)},
           {"Fx_N", F.x},                {"Fy_N", F.y},                    {"force_N", norm(F)}};
+  std::vector<double> values;
+  for (const auto& [k, v] : j.items())
+    if (v.is_number()) values.push_back(v.get<double>());
+  require_finite(values, {x, y}, "field probe", keys, "a point off the magnet's corners and edges");
+  return j;
 }
 }  // namespace nipdem::nip

@@ -54,9 +54,31 @@ struct FieldSetup {
 // The field, toner and radius of `o` (checked with check_field_options first); throws InputError
 // for magnet overrides given with a map, or a map that does not read.
 FieldSetup make_field_setup(const FieldOptions& o);
-// `field probe` (CLI and Python): B, grad B, the induced moment (eq. 4.5.1 magnetisation curve)
+// The magnet's material (closed polygons, [m], MagnetField::material()) holds no toner: the field
+// there is the one inside a magnet, and on the blocks' corners the analytic field is singular
+// (log; NaN exactly on one). Empty for a source that does not know its material (a field map).
+class MagnetMaterial {
+ public:
+  explicit MagnetMaterial(const magnet::MagnetField& f);
+  // Throws InputError (where, keys, "point (x, y) m") for a point on or inside a block, naming the
+  // region allowed: "<allowed_prefix> outside the magnet's blocks, e.g. y > <top> m (their top)".
+  void require_outside(Vec2 p, const std::string& where, const std::string& keys, const std::string& allowed_prefix) const;
+  double top() const { return top_; }  // highest point of the material (above it a point is outside)
+
+ private:
+  std::vector<std::vector<Vec2>> blocks_;
+  double top_;
+};
+// Backstop for what the material test cannot see (a point next to a corner, a map with a tiny
+// spacing): throws InputError naming `keys` and the point unless every value is finite.
+void require_finite(const std::vector<double>& values, Vec2 p, const std::string& where, const std::string& keys,
+                    const std::string& allowed);
+
+// `field probe` -- the one check and computation of the CLI command and of Python's
+// nipdem.field_probe: B, grad B, the induced moment (eq. 4.5.1 magnetisation curve)
 // and the magnet force (m . grad) B (eq. 2.4.34) on a toner of the options' radius at (x, y) [m];
-// checks x, y and the options (InputError naming `field probe` and the option). JSON keys as
+// checks x, y in [-1, 1] m, the options, a point on or inside an analytic magnet's blocks and
+// values that are not finite (InputError naming `field probe` and the option). JSON keys as
 // docs/cli-contract.md: preset, source, x_m, y_m, Bx_T, By_T, B_T, dB*_d*_T_per_m, radius_m,
 // mx_Am2, my_Am2, moment_Am2, Fx_N, Fy_N, force_N.
 nlohmann::json field_probe(const FieldOptions& o, double x_m, double y_m);
