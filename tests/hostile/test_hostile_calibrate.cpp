@@ -15,16 +15,14 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 constexpr int kBoundSeconds = 60;  // wall-clock bound of one refused input (each takes < 1 s)
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
 const std::string kEx = std::string(NIPDEM_SOURCE_DIR) + "/examples/calibration/";
 const std::string kPlate = kEx + "friction_plate.csv";
@@ -37,25 +35,10 @@ const std::string kVsm = kEx + "vsm_black.csv";
 const std::string kDrop = "calibrate restitution --y0 1e-3 --radius 1e-3 --density 1500 --viscosity 1.8e-5 --json";
 const std::string kCentrifugalRun = "calibrate adhesion --data " + kCentrifugal + " --method centrifugal --initial-count 1000";
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_cal_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_cal_", name); }
 
 void expect_refused(const std::vector<Case>& cases, const std::string& tag) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, tag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err;
-    EXPECT_EQ(r.status, 2) << r.err << "\nstdout: " << r.out.substr(0, 400);
-    EXPECT_EQ(r.out.find("null"), std::string::npos) << r.out.substr(0, 400);
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err;
-    EXPECT_LT(r.seconds, 10.0) << "a refused input must be refused quickly";
-  }
+  nipdem::test::hostile::expect_cases(cases, tag, {.max_seconds = 10.0, .no_null = true});
 }
 }  // namespace
 

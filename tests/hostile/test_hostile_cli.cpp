@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 #include "nipdem/core/rng.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
@@ -22,10 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 constexpr int kBoundSeconds = 60;  // wall-clock bound of one refused input (they take < 1 s alone)
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
 const std::string kSrc = NIPDEM_SOURCE_DIR;
 const std::string kBlack = kSrc + "/data/presets/black.toml";
@@ -33,28 +31,11 @@ const std::string kBlack = kSrc + "/data/presets/black.toml";
 const std::string kSmall = " --set geometry.window_x_min_m=-100e-6 --set geometry.window_x_max_m=100e-6"
                            " --set collision.stiffness_scale=0.01 --set output.vtk=false --quiet";
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-std::string write(const fs::path& p, const std::string& text) {
-  nipdem::io::write_file_atomic(p, text);
-  return p.string();
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_", name); }
+using nipdem::test::hostile::write;
 
 void expect_refused(const std::vector<Case>& cases, const std::string& tag) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, tag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err;
-    EXPECT_EQ(r.status, 2) << r.err;
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err;
-    EXPECT_LT(r.seconds, kBoundSeconds);
-  }
+  nipdem::test::hostile::expect_cases(cases, tag, {.max_seconds = kBoundSeconds});
 }
 }  // namespace
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;
@@ -19,21 +20,10 @@ namespace fs = std::filesystem;
 namespace {
 constexpr int kBoundSeconds = 60;  // wall-clock bound of one refused input (they take < 1 s alone)
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_field_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-std::string write(const fs::path& p, const std::string& text) {
-  nipdem::io::write_file_atomic(p, text);
-  return p.string();
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_field_", name); }
+using nipdem::test::hostile::write;
 // A regular 6 x 6 map (20 um spacing) whose node (i, j) = (2, 3) (file line 22) holds `bad`
 // in column `column` (2: Bx, 3: By); every other value is ordinary.
 std::string map_with(const fs::path& p, const std::string& header, int column, const std::string& bad) {
@@ -48,16 +38,7 @@ std::string map_with(const fs::path& p, const std::string& header, int column, c
 }
 
 void expect_refused(const std::vector<Case>& cases, const std::string& tag) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, tag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err;
-    EXPECT_EQ(r.status, 2) << r.err;
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err;
-    EXPECT_LT(r.seconds, kBoundSeconds);
-  }
+  nipdem::test::hostile::expect_cases(cases, tag, {.max_seconds = kBoundSeconds});
 }
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;
@@ -23,21 +24,10 @@ namespace {
 constexpr int kBoundSeconds = 60;
 const std::string kTag = "hostile_ldc";
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_ldc_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-std::string write(const fs::path& p, const std::string& text) {
-  nipdem::io::write_file_atomic(p, text);
-  return p.string();
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_ldc_", name); }
+using nipdem::test::hostile::write;
 
 // The setup of docs/ldc.md on a 40 x 40 grid, with `disc` as its one disc and `extra` keys first.
 std::string setup(const std::string& extra = "", const std::string& disc = R"("x_m": 5e-4, "y_m": 5e-4, "radius_m": 5e-6, "charge_C_per_m": 1e-10)",
@@ -53,17 +43,7 @@ std::string setup(const std::string& extra = "", const std::string& disc = R"("x
 
 // Every case ends with `status`, stdout empty, stderr naming each needle in at most `max_err` bytes.
 void expect_status(const std::vector<Case>& cases, int status, std::size_t max_err = 2000) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, kTag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err.substr(0, 300);
-    EXPECT_EQ(r.status, status) << r.err.substr(0, 300) << r.out.substr(0, 300);
-    EXPECT_EQ(r.out, "") << "printed a result";
-    EXPECT_LE(r.err.size(), max_err) << "message not one short line: " << r.err.substr(0, 300) << "...";
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err.substr(0, 500);
-  }
+  nipdem::test::hostile::expect_cases(cases, kTag, {.status = status, .bound_s = kBoundSeconds, .stdout_empty = true, .max_err = max_err});
 }
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;
@@ -22,33 +23,17 @@ namespace fs = std::filesystem;
 namespace {
 constexpr int kBoundSeconds = 60;
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
 const std::string kSrc = NIPDEM_SOURCE_DIR;
 const std::string kBlack = kSrc + "/data/presets/black.toml";
 const std::string kSmall = " --set geometry.window_x_min_m=-100e-6 --set geometry.window_x_max_m=100e-6"
                            " --set collision.stiffness_scale=0.01 --quiet";
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_out_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_out_", name); }
 
 void expect_refused(const std::vector<Case>& cases, const std::string& tag) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, tag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err;
-    EXPECT_EQ(r.status, 2) << r.err;
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err;
-  }
+  nipdem::test::hostile::expect_cases(cases, tag, {});
 }
 
 // Names in `dir` (not recursive) that look like a temp file of write_file_atomic.

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../cli_run.hpp"
+#include "support/hostile.hpp"
 #include "nipdem/io/atomic_file.hpp"
 
 namespace fs = std::filesystem;
@@ -21,10 +22,7 @@ namespace fs = std::filesystem;
 namespace {
 constexpr int kBoundSeconds = 30;  // wall-clock bound of one refused input (each takes well under 1 s)
 
-struct Case {
-  std::string args;                  // after `nipdem`
-  std::vector<std::string> needles;  // each must appear in stderr
-};
+using nipdem::test::hostile::Case;
 
 const std::string kSrc = NIPDEM_SOURCE_DIR;
 const std::string kLine = kSrc + "/examples/patterns/line.toml";
@@ -32,12 +30,7 @@ const std::string kResponse = "rc response --R 5.9e11 --Rd 1.8e24 --C 3.9e-16 --
 const std::string kElectric = "force electric --radius 5e-6 --voltage 100 --gap 1e-6 --json";
 const std::string kDipole = "force dipole --moment 3.7e-11 --distance 13e-6 --angle 0 --json";
 
-fs::path scratch(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("nipdem_hostile_rc_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch(const std::string& name) { return nipdem::test::hostile::scratch("nipdem_hostile_rc_", name); }
 
 // A valid 20-row probe measurement: the thesis' black toner (R = 5.9e11 ohm, C = 3.9e-16 F,
 // Rd = 1.8e24 ohm, Rm = 1e4 ohm, 40 V) at 100..2000 Hz, amplitudes of 1e5 particles x `scale`
@@ -63,16 +56,7 @@ std::string rc_csv(double scale, const std::vector<std::pair<int, std::string>>&
 }
 
 void expect_refused(const std::vector<Case>& cases, const std::string& tag) {
-  for (const auto& c : cases) {
-    SCOPED_TRACE("nipdem " + c.args);
-    const auto r = nipdem::test::run_cli_bounded(c.args, tag, kBoundSeconds);
-    if (std::getenv("NIPDEM_HOSTILE_VERBOSE")) std::fprintf(stderr, "[%d] nipdem %s\n    %s", r.status, c.args.c_str(), r.err.c_str());
-    EXPECT_FALSE(r.timed_out) << "hung (killed after " << kBoundSeconds << " s)";
-    EXPECT_EQ(r.signal, 0) << "died of signal " << r.signal << ": " << r.err;
-    EXPECT_EQ(r.status, 2) << r.err << r.out.substr(0, 300);
-    EXPECT_TRUE(r.out.empty()) << "printed a result: " << r.out.substr(0, 300);
-    for (const auto& n : c.needles) EXPECT_NE(r.err.find(n), std::string::npos) << "stderr does not name '" << n << "': " << r.err;
-  }
+  nipdem::test::hostile::expect_cases(cases, tag, {.bound_s = kBoundSeconds, .stdout_empty = true});
 }
 }  // namespace
 
