@@ -179,3 +179,34 @@ TEST(WallQuery, PeriodHintNeverChangesTheHits) {
   EXPECT_GT(hits_total, 1000);  // the sample does exercise contacts
   EXPECT_GT(fast_hits, 1000);   // and the hint's fast path
 }
+
+// The pyramid profile (§2.1, figs 2.6-2.7) against its own geometry, with a flat between the
+// pyramids and without one (spacing 0, side by side: one vertex fewer). Each period holds one
+// triangle of base B and height h (area B h / 2 by the trapezoid rule over the vertices, exact
+// for a polygon), the periods fill the circumference, and the deepest point is h. Tolerance:
+// rounding of sums of a few lengths of ~1e-5 m (1e-12 relative).
+TEST(WallProfile, PyramidsWithAndWithoutAFlatHaveTheirGeometry) {
+  for (const double spacing : {20e-6, 0.0}) {
+    SCOPED_TRACE(spacing);
+    geometry::Wall w;
+    w.kind = geometry::Wall::Kind::cylinder;
+    w.name = "roller";
+    w.centre = {0.0, -0.02};
+    w.radius = 0.02;
+    const double h = 7.1e-6, base = 50e-6;
+    geometry::set_pyramid_roughness(w, h, base, spacing);
+    ASSERT_EQ(w.profile.size(), spacing > 0 ? 4u : 3u);
+    const double circumference = 2.0 * 3.14159265358979323846 * w.radius;
+    EXPECT_NEAR(w.period() * w.n_periods, circumference, 1e-12 * circumference);
+    const double scale = w.period() / (base + spacing);  // the stretch that fits whole periods
+    double area = 0.0, deepest = 0.0;
+    for (std::size_t k = 0; k + 1 < w.profile.size(); ++k) {
+      const Vec2 a = w.profile[k], b = w.profile[k + 1];
+      EXPECT_GT(b.x, a.x);  // arc length increases
+      area += 0.5 * (a.y + b.y) * (b.x - a.x);
+      deepest = std::max(deepest, b.y);
+    }
+    EXPECT_NEAR(area, 0.5 * base * scale * h, 1e-12 * base * h);
+    EXPECT_DOUBLE_EQ(deepest, h);
+  }
+}
