@@ -595,6 +595,7 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     else pair_rows<A, Per, 0>(i0, i1, f, nc, sub, sn);
   };
   const int run = team();  // threads that run the nt parts (results depend on nt only)
+  body_blocks_.reset((nb + kBodyBlock - 1) / kBodyBlock, run);
   const bool simple_blocks = simple_valid_ && simple_prefix_.size() == static_cast<std::size_t>(nb) + 1;
 #pragma omp parallel num_threads(run)
   {
@@ -631,14 +632,13 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     // each disc's thread buffers in fixed thread order (bitwise reproducible for a given thread
     // count), add its wall forces, then sum its bodies (and kick them). A body's discs are in the
     // same share as the body, so no barrier is needed between the discs and the bodies.
-    const int bl = static_cast<int>(static_cast<std::int64_t>(nb) * t / team_size);
-    const int bh = static_cast<int>(static_cast<std::int64_t>(nb) * (t + 1) / team_size);
     // In blocks of bodies, so that a block's disc sums are still in L1 when its bodies read them.
-    constexpr int kBlock = 256;
+    // Each thread starts on its own share of the blocks and then takes what is left of the
+    // others' (BlockSteal): the wall contacts are not spread evenly over the bodies.
     double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
     const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
-    for (int c0 = bl; c0 < bh; c0 += kBlock) {
-      const int c1 = std::min(bh, c0 + kBlock);
+    for (int q = body_blocks_.next(t); q >= 0; q = body_blocks_.next(t)) {
+      const int c0 = q * kBodyBlock, c1 = std::min(nb, c0 + kBodyBlock);
       const int k0 = b_.first_disc[c0], k1 = c1 < nb ? b_.first_disc[c1] : n;
       // the force providers' arrays, cleared for provider_forces() (which follows every call)
       for (std::size_t k = 0; k < forces_.size(); ++k) {

@@ -28,6 +28,7 @@
 
 #include "nipdem/core/particles.hpp"
 #include "nipdem/core/vec2.hpp"
+#include "nipdem/engine/block_steal.hpp"
 #include "nipdem/engine/team_tuner.hpp"
 #include "nipdem/geometry/neighbor_list.hpp"
 #include "nipdem/geometry/walls.hpp"
@@ -248,6 +249,9 @@ class Simulation {
   // partners (j > i, which may lie anywhere after split_[t+1]: across a periodic seam, the far
   // end of the order). part_touch_[t * touch_blocks_ + (i >> kTouchShift)] is 1 if it may write
   // disc i: only those blocks of its buffer are read and zeroed.
+  // contact_forces()' per-body phase: blocks of kBodyBlock bodies, shared out by stealing
+  static constexpr int kBodyBlock = 256;
+  BlockSteal body_blocks_;
   static constexpr int kTouchShift = 6;
   std::vector<int> split_;
   std::vector<std::uint8_t> part_touch_;
