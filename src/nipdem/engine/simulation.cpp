@@ -684,10 +684,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
         const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];
         if (wm != 0) {
           try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
-            wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t], wall_nc);
+            wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t].v, wall_nc);
             if (take_near)
               wall_near_[i] = walls_near(static_cast<std::size_t>(i), sub_per_disc_ ? sub_g_[i] + 0.5 * margin : margin,
-                                         thread_hits_[t]);
+                                         thread_hits_[t].v);
           } catch (...) {
             if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
           }

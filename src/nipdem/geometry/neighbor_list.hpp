@@ -135,7 +135,10 @@ class NeighborList {
   std::vector<int> new_start_, new_nbr_;
   std::vector<double> new_eta_;
   std::vector<std::uint8_t> new_slide_;
-  struct Rows {  // one thread's consecutive rows during a build
+  // One thread's consecutive rows during a build. On cache lines of its own: the vectors' ends
+  // are written at every pair, and two threads writing one line take it from each other at
+  // every write (false sharing).
+  struct alignas(64) Rows {
     std::vector<int> nbr, row;
     std::vector<double> eta;
     std::vector<std::uint8_t> slide;

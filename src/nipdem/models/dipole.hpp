@@ -84,11 +84,13 @@ class PairSum {
   struct Binned { double x, y; int index; };  // a particle in cell order
   std::vector<int> cell_start_, cell_fill_, cell_of_;  // cell-list scratch (counting sort)
   std::vector<Binned> binned_;
-  struct BuildPart { std::vector<int> nbr, cand; int max_row = 0; };  // rebuild(): one part's rows
+  // rebuild(): one part's rows. On cache lines of its own: its vectors' ends and max_row are
+  // written at every row, and parts run on different threads (no false sharing).
+  struct alignas(64) BuildPart { std::vector<int> nbr, cand; int max_row = 0; };
   std::vector<BuildPart> parts_;
   int max_row_ = 0;                        // longest row of the list
   // Per part: one row's partners within r_c (separation, moment, index) and their forces
-  struct RowScratch { std::vector<double> dx, dy, mx, my, gx, gy; std::vector<int> j; };
+  struct alignas(64) RowScratch { std::vector<double> dx, dy, mx, my, gx, gy; std::vector<int> j; };
   std::vector<RowScratch> rows_;
 };
 
