@@ -628,10 +628,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     }
     std::int64_t wall_nc = 0;
 #pragma omp barrier
-    // This thread's share of the bodies and their discs (bodies own consecutive discs): reduce
-    // each disc's thread buffers in fixed thread order (bitwise reproducible for a given thread
-    // count), add its wall forces, then sum its bodies (and kick them). A body's discs are in the
-    // same share as the body, so no barrier is needed between the discs and the bodies.
+    // Blocks of bodies and their discs (bodies own consecutive discs): reduce each disc's part
+    // buffers in fixed part order (bitwise reproducible for a given part count, whichever thread
+    // does it), add its wall forces, then sum its bodies (and kick them). A body's discs are in
+    // the same block as the body, so no barrier is needed between the discs and the bodies.
     // In blocks of bodies, so that a block's disc sums are still in L1 when its bodies read them.
     // Each thread starts on its own share of the blocks and then takes what is left of the
     // others' (BlockSteal): the wall contacts are not spread evenly over the bodies.

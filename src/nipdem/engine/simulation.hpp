@@ -245,13 +245,13 @@ class Simulation {
   std::vector<PackedDisc> pdisc_;
   std::vector<PackedVel> pvel_;
   std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers
+  // contact_forces()' per-body phase: blocks of kBodyBlock bodies, shared out by stealing
+  static constexpr int kBodyBlock = 256;
+  BlockSteal body_blocks_;
   // Thread t owns list rows [split_[t], split_[t+1]) and writes its own discs and their listed
   // partners (j > i, which may lie anywhere after split_[t+1]: across a periodic seam, the far
   // end of the order). part_touch_[t * touch_blocks_ + (i >> kTouchShift)] is 1 if it may write
   // disc i: only those blocks of its buffer are read and zeroed.
-  // contact_forces()' per-body phase: blocks of kBodyBlock bodies, shared out by stealing
-  static constexpr int kBodyBlock = 256;
-  BlockSteal body_blocks_;
   static constexpr int kTouchShift = 6;
   std::vector<int> split_;
   std::vector<std::uint8_t> part_touch_;
