@@ -80,7 +80,12 @@ class PairSum {
   std::vector<double> x0_, y0_;            // positions at the last build
   struct alignas(32) Packed { double x, y, mx, my; };
   std::vector<Packed> pk_;                 // per pass: centre and moment of every particle
-  std::vector<std::vector<double>> buf_;   // per-thread force buffers (fx, fy interleaved)
+  std::vector<std::vector<double>> buf_;   // per-part force buffers (fx, fy interleaved)
+  // per part: the particles [lo, hi) its rows write to (its own and their partners), found at
+  // the first pass after each list build; only these of its buffer are cleared and read
+  std::vector<int> part_lo_, part_hi_;
+  int reach_builds_ = -1;
+  long reach_n_ = -1;
   struct Binned { double x, y; int index; };  // a particle in cell order
   std::vector<int> cell_start_, cell_fill_, cell_of_;  // cell-list scratch (counting sort)
   std::vector<Binned> binned_;

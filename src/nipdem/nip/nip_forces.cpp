@@ -124,9 +124,11 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
 
 void MagnetForce::field_pass(const BodyStore& b) {
   const std::size_t n = b.x.size();
+  // (every value is written below, by the thread that adds it to the bodies at each step: not
+  // cleared here first by one thread, which would put every line in that thread's cache)
   moment_.resize(n);
-  ffx_.assign(n, 0.0);
-  ffy_.assign(n, 0.0);
+  ffx_.resize(n);
+  ffy_.resize(n);
   const int nt = std::max(1, cfg_.threads);
   if (nt == 1) {
     for (std::size_t i = 0; i < n; ++i) {
