@@ -133,9 +133,11 @@ class TimedForce final : public engine::BodyForce {
            std::span<double> tq) override {
     const auto t0 = std::chrono::steady_clock::now();
     f_->set_running_threads(running_threads());  // the engine's thread choice reaches the magnet's loops
+    f_->set_hand_held(hand_held());               // and the engine's offer to add its held forces
     f_->add(b, d, t, fx, fy, tq);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  Held held() const override { return f_->held(); }
   void save(std::ostream& o) const override { f_->save(o); }
   void load(std::istream& in) override { f_->load(in); }
   double seconds = 0.0;

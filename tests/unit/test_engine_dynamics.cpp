@@ -320,3 +320,65 @@ TEST(Checkpoint, ResumeIsBitwiseIdentical) {
     EXPECT_EQ(ref.time(), b.time());
   }
 }
+
+namespace {
+// A provider that keeps two per-body force terms between evaluations (recomputed every 3rd
+// call from the positions, as the magnet does) plus a direct term it always adds in add().
+// With take_up = false it adds everything itself; with true it hands the two held terms to the
+// engine (BodyForce::Held) when the engine offers.
+struct TwoTermHeld : BodyForce {
+  bool take_up;
+  explicit TwoTermHeld(bool t) : take_up(t) {}
+  std::vector<double> ax, ay, bx, by;
+  int calls = 0;
+  std::string name() const override { return "two-term"; }
+  void add(const BodyStore& b, const DiscStore&, double, std::span<double> fx, std::span<double> fy,
+           std::span<double> tq) override {
+    const std::size_t n = b.x.size();
+    if (calls++ % 3 == 0 || ax.size() != n) {
+      ax.resize(n); ay.resize(n); bx.resize(n); by.resize(n);
+      for (std::size_t i = 0; i < n; ++i) {  // arbitrary smooth fields with values that round
+        ax[i] = 3e-12 * std::sin(1e5 * b.x[i]); ay[i] = -1e-11 / 3.0 + 1e-12 * b.y[i] / 7e-6;
+        bx[i] = 1e-12 / 7.0 * std::cos(3e5 * b.y[i]); by[i] = 2e-12 * std::sin(2e5 * b.x[i] + 1.0);
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i) { fx[i] += 1e-13 / 3.0; tq[i] += 1e-19 * b.omega[i]; }
+    if (take_up && hand_held()) return;
+    for (std::size_t i = 0; i < n; ++i) { fx[i] += ax[i]; fy[i] += ay[i]; fx[i] += bx[i]; fy[i] += by[i]; }
+  }
+  Held held() const override {
+    if (!take_up || !hand_held()) return {};
+    Held h;
+    h.fx = {ax.data(), bx.data()};
+    h.fy = {ay.data(), by.data()};
+    h.terms = 2;
+    return h;
+  }
+};
+}  // namespace
+
+// Held forces added by the engine (BodyForce::Held) are the same operations as add() adding
+// them into its cleared arrays: the same bits in the bodies' motion and in the provider's
+// arrays (provider_fx, which outputs read), at 1 and 2 threads.
+TEST(HeldForces, EngineAddsThemWithTheBitsAddWouldGive) {
+  for (int threads : {1, 2}) {
+    Simulation a = make_box(0.6, true, true, Integrator::velocity_verlet, 1.0 / 30, 5, threads);
+    Simulation b = make_box(0.6, true, true, Integrator::velocity_verlet, 1.0 / 30, 5, threads);
+    auto pa = std::make_shared<TwoTermHeld>(false), pb = std::make_shared<TwoTermHeld>(true);
+    a.add_force(pa);
+    b.add_force(pb);
+    for (int i = 0; i < 200; ++i) { a.step(); b.step(); }
+    ASSERT_EQ(a.bodies().x.size(), b.bodies().x.size());
+    for (std::size_t i = 0; i < a.bodies().x.size(); ++i) {
+      EXPECT_EQ(a.bodies().x[i], b.bodies().x[i]);
+      EXPECT_EQ(a.bodies().vx[i], b.bodies().vx[i]);
+      EXPECT_EQ(a.bodies().omega[i], b.bodies().omega[i]);
+      EXPECT_EQ(a.provider_fx(0)[i], b.provider_fx(0)[i]);
+      EXPECT_EQ(a.provider_fy(0)[i], b.provider_fy(0)[i]);
+    }
+    // the held terms reached the motion (a provider adding nothing would move the bodies otherwise)
+    EXPECT_NE(b.provider_fx(0)[0], 1e-13 / 3.0);
+    // and the offer ends with the engine's call: a direct add() adds everything
+    EXPECT_FALSE(pb->hand_held());
+  }
+}

@@ -123,3 +123,32 @@ TEST(NipMagnetForce, AMapAskedOutsideItsRangeFailsCleanlyOnAnyThreadCount) {
     EXPECT_NE(msg.find("(0.0005, "), std::string::npos) << "the lowest index is reported: " << msg;
   }
 }
+
+// Offered by the engine (BodyForce::hand_held), the magnet leaves its held forces out of add()
+// and returns them from held(): the field term and the dipole-dipole term, which the engine adds
+// as 0 + field + dipole, the bits add() gives (engine test HeldForces.*).
+TEST(NipMagnetForce, HandsItsHeldForcesToTheEngineWhenOffered) {
+  auto field = make_magnet_field(MagnetConfig{});
+  for (bool dd : {false, true}) {
+    MagnetConfig c;
+    c.dipole_dipole = dd;
+    MagnetForce direct(field, c), handed(field, c);
+    handed.set_hand_held(true);
+    BodyStore b = bodies(60, 7);
+    DiscStore d;
+    std::vector<double> fx(60, 0.0), fy(60, 0.0), tq(60, 0.0), gx(60, 0.0), gy(60, 0.0), gt(60, 0.0);
+    direct.add(b, d, 0.0, fx, fy, tq);
+    handed.add(b, d, 0.0, gx, gy, gt);
+    EXPECT_TRUE(direct.held().terms == 0);
+    const auto h = handed.held();
+    ASSERT_EQ(h.terms, dd ? 2 : 1);
+    for (int i = 0; i < 60; ++i) {
+      EXPECT_EQ(gx[i], 0.0);
+      double px = gx[i], py = gy[i];
+      for (int q = 0; q < h.terms; ++q) { px += h.fx[q][i]; py += h.fy[q][i]; }
+      EXPECT_EQ(px, fx[i]);
+      EXPECT_EQ(py, fy[i]);
+    }
+    EXPECT_NE(fx[0], 0.0);
+  }
+}

@@ -900,18 +900,28 @@ void Simulation::provider_forces(double kick_h) {
   const std::size_t nb = b_.x.size();
   const std::size_t np = forces_.size();
   if (np == 0) return;
+  held_.resize(np);
   for (std::size_t k = 0; k < np; ++k) {
     forces_[k]->set_running_threads(team());
+    forces_[k]->set_hand_held(true);
     forces_[k]->add(b_, d_, time_, prov_fx_[k], prov_fy_[k], prov_tq_[k]);
+    held_[k] = forces_[k]->held();
+    forces_[k]->set_hand_held(false);  // (a direct call of add() elsewhere adds everything)
+    if (held_[k].terms < 0 || held_[k].terms > BodyForce::Held::kMaxTerms)
+      throw std::logic_error(fmt::format("force provider {}: {} held terms", forces_[k]->name(), held_[k].terms));
   }
   double* fx = b_.fx.data(); double* fy = b_.fy.data(); double* tq = b_.torque.data();
   double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
   const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
   const bool kick = kick_h > 0.0;
+  const BodyForce::Held* held = held_.data();
 #pragma omp parallel for schedule(static) num_threads(team())
   for (std::size_t b = 0; b < nb; ++b) {
     for (std::size_t k = 0; k < np; ++k) {
-      fx[b] += prov_fx_[k][b]; fy[b] += prov_fy_[k][b]; tq[b] += prov_tq_[k][b];
+      double px = prov_fx_[k][b], py = prov_fy_[k][b];
+      for (int q = 0; q < held[k].terms; ++q) { px += held[k].fx[q][b]; py += held[k].fy[q][b]; }
+      if (held[k].terms > 0) { prov_fx_[k][b] = px; prov_fy_[k][b] = py; }
+      fx[b] += px; fy[b] += py; tq[b] += prov_tq_[k][b];
     }
     if (kick) { vx[b] += kick_h * fx[b] * im[b]; vy[b] += kick_h * fy[b] * im[b]; om[b] += kick_h * tq[b] * iI[b]; }
   }

@@ -17,6 +17,7 @@
 //    own: a caller that changes the body set anyway (the nip's inflow/outflow pass) sorts then
 //    (sort_bodies_spatially), at moments fixed by the run, so a resumed run sorts at the same steps.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <exception>
 #include <functional>
@@ -69,9 +70,25 @@ class BodyForce {
   // threads, so that it gives way on a contended machine as the engine does, with the same results.
   int running_threads() const { return running_threads_; }
   void set_running_threads(int n) { running_threads_ = n; }
+  // Per-body force arrays a provider keeps between evaluations (e.g. the magnet's forces of its
+  // last field pass, held for several steps) may be added by the engine in its own pass over
+  // the bodies instead of by add() in a pass (a parallel region) of its own. The engine sets
+  // hand_held(true) before add(); a provider that takes it up leaves those terms out of add()
+  // and returns them from held() after it. The engine then adds, per body, the provider's
+  // array value + term 0 + term 1 (the same operations as add() adding them into the cleared
+  // array, so the same bits) and stores that sum back in the provider's array.
+  struct Held {
+    static constexpr int kMaxTerms = 2;
+    std::array<const double*, kMaxTerms> fx{}, fy{};  // [N] per body, valid until the next add()
+    int terms = 0;
+  };
+  virtual Held held() const { return {}; }
+  bool hand_held() const { return hand_held_; }
+  void set_hand_held(bool on) { hand_held_ = on; }
 
  private:
   int running_threads_ = 0;
+  bool hand_held_ = false;
 };
 
 struct EngineParams {
@@ -242,6 +259,7 @@ class Simulation {
   bool forces_valid_ = false;
   std::vector<std::shared_ptr<BodyForce>> forces_;
   std::vector<std::vector<double>> prov_fx_, prov_fy_, prov_tq_;
+  std::vector<BodyForce::Held> held_;  // per provider, the held terms of its last add()
   std::vector<PackedDisc> pdisc_;
   std::vector<PackedVel> pvel_;
   std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers

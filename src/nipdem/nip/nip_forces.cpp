@@ -106,6 +106,7 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
   if (cfg_.dipole_dipole && (!same || calls_ % cfg_.dipole_interval == 0)) dipole_pass(b, same);
   if (!same) ids_.assign(b.id.begin(), b.id.end());
   ++calls_;
+  if (hand_held()) return;  // the engine adds the held forces (held()) in its own pass
   // The held forces, added per body (the same sums for any thread count), on the engine's
   // threads when there are enough bodies to pay for the region: a serial pass here is time
   // the engine's other threads wait.
@@ -120,6 +121,15 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
     ox[i] += hx[i]; oy[i] += hy[i];
     if (dd) { ox[i] += gx[i]; oy[i] += gy[i]; }
   }
+}
+
+engine::BodyForce::Held MagnetForce::held() const {
+  if (!hand_held()) return {};
+  Held h;
+  h.fx[0] = ffx_.data(); h.fy[0] = ffy_.data();
+  h.terms = 1;
+  if (cfg_.dipole_dipole) { h.fx[1] = dfx_.data(); h.fy[1] = dfy_.data(); h.terms = 2; }
+  return h;
 }
 
 void MagnetForce::field_pass(const BodyStore& b) {

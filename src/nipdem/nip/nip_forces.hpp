@@ -52,6 +52,9 @@ class MagnetForce final : public engine::BodyForce {
   std::string name() const override { return "magnetic"; }
   void add(const BodyStore& b, const DiscStore& d, double t, std::span<double> fx, std::span<double> fy,
            std::span<double> torque) override;
+  // The field force and the dipole-dipole force of the last evaluation, for the engine to add
+  // (engine::BodyForce::Held; add() then leaves them out).
+  Held held() const override;
   // Dipole-dipole part of the last evaluation, per body [N] (for tests and output).
   const std::vector<double>& dipole_fx() const { return dfx_; }
   const std::vector<double>& dipole_fy() const { return dfy_; }
