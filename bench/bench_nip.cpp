@@ -134,6 +134,7 @@ class TimedForce final : public engine::BodyForce {
     const auto t0 = std::chrono::steady_clock::now();
     f_->set_running_threads(running_threads());  // the engine's thread choice reaches the magnet's loops
     f_->set_hand_held(hand_held());               // and the engine's offer to add its held forces
+    f_->set_body_set_version(body_set_version());
     f_->add(b, d, t, fx, fy, tq);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -382,3 +382,57 @@ TEST(HeldForces, EngineAddsThemWithTheBitsAddWouldGive) {
     EXPECT_FALSE(pb->hand_held());
   }
 }
+
+namespace {
+struct VersionSpy : BodyForce {
+  std::vector<std::uint64_t> seen;
+  std::string name() const override { return "spy"; }
+  void add(const BodyStore&, const DiscStore&, double, std::span<double>, std::span<double>, std::span<double>) override {
+    seen.push_back(body_set_version());
+  }
+};
+}  // namespace
+
+// The body-set number a provider sees (BodyForce::body_set_version): the same while the bodies
+// only move, a new one after bodies are added, removed or reordered or a state is loaded (the
+// magnet and electric providers then compare their ids), never 0 from the engine, 0 after the call.
+TEST(HeldForces, BodySetNumberChangesExactlyWithTheBodySet) {
+  Simulation a = make_box(0.6, true, true, Integrator::velocity_verlet, 1.0 / 30, 5);
+  auto spy = std::make_shared<VersionSpy>();
+  a.add_force(spy);
+  auto last = [&] { return spy->seen.back(); };
+  a.step();
+  const auto v0 = last();
+  EXPECT_NE(v0, 0u);
+  for (int i = 0; i < 5; ++i) a.step();
+  EXPECT_EQ(last(), v0);
+  EXPECT_EQ(spy->body_set_version(), 0u);
+  a.add_body(single(2e-6, {20e-6, 30e-6}));
+  a.step();
+  const auto v1 = last();
+  EXPECT_NE(v1, v0);
+  a.step();
+  EXPECT_EQ(last(), v1);
+  const int n = static_cast<int>(a.bodies().x.size());
+  std::vector<int> order(n);
+  for (int i = 0; i < n; ++i) order[i] = n - 1 - i;
+  a.permute_bodies(order);
+  a.step();
+  const auto v2 = last();
+  EXPECT_NE(v2, v1);
+  EXPECT_EQ(a.remove_bodies_if([](int i) { return i == 0; }), 1u);
+  a.step();
+  const auto v3 = last();
+  EXPECT_NE(v3, v2);
+  std::stringstream ss;
+  a.save(ss);
+  a.load(ss);
+  a.step();
+  EXPECT_NE(last(), v3);
+  // another engine's numbers are its own
+  Simulation b = make_box(0.6, true, true, Integrator::velocity_verlet, 1.0 / 30, 5);
+  b.add_force(spy);
+  const std::size_t before = spy->seen.size();
+  b.step();
+  for (std::size_t k = 0; k < before; ++k) EXPECT_NE(last(), spy->seen[k]);
+}

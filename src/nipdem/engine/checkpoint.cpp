@@ -209,7 +209,7 @@ void Simulation::load(std::istream& in) try {
   // the saved renumbering if bodies changed since its build; forces of the saved state are in
   // the body arrays if they were valid when it was saved.
   old_of_new_ = std::move(old_of_new);
-  structure_changed_ = true;
+  body_set_changed();
   simple_valid_ = false;
   forces_valid_ = forces_valid != 0;
   for (auto& f : forces_) f->load(in);

@@ -1,6 +1,7 @@
 #include "nipdem/engine/simulation.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -26,6 +27,12 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 }  // namespace
+
+void Simulation::body_set_changed() {
+  static std::atomic<std::uint64_t> versions{0};  // (unique across the process's engines)
+  structure_changed_ = true;
+  body_set_version_ = ++versions;
+}
 
 Simulation::Simulation(EngineParams params, std::vector<geometry::Wall> walls)
     : params_(std::move(params)), walls_(std::move(walls)) {
@@ -111,7 +118,7 @@ int Simulation::add_body(const BodySpec& s) {
   for (auto& v : prov_fx_) v.push_back(0.0);
   for (auto& v : prov_fy_) v.push_back(0.0);
   for (auto& v : prov_tq_) v.push_back(0.0);
-  structure_changed_ = true;
+  body_set_changed();
   simple_valid_ = false;
   forces_valid_ = false;
   return static_cast<int>(bi);
@@ -154,7 +161,7 @@ std::size_t Simulation::remove_bodies_if(const std::function<bool(int)>& pred) {
   for (auto& v : prov_fy_) v.resize(bw);
   for (auto& v : prov_tq_) v.resize(bw);
   old_of_new_.swap(new_old_of_new);
-  structure_changed_ = true;
+  body_set_changed();
   simple_valid_ = false;
   forces_valid_ = false;
   return count;
@@ -193,7 +200,7 @@ void Simulation::permute_bodies(std::span<const int> order) {
     b_.first_disc[b] = static_cast<int>(k);
     for (int q = 0; q < b_.n_discs[b]; ++q) d_.body[k++] = static_cast<int>(b);
   }
-  structure_changed_ = true;
+  body_set_changed();
   simple_valid_ = false;
   ensure_neighbor_list(-1);  // now: energy() and the history mapping read the list
 }
@@ -315,24 +322,29 @@ void Simulation::choose_skins() {
   half_skin_.clear();
   if (q <= 0.0 || n < 2) return;
   speed_.resize(n);
+  half_skin_.resize(n);
+  // (the loops on the engine's threads: at a list build every few tens of steps at
+  // stiffness_scale 0.01, a serial pass here is time the other threads wait)
+#pragma omp parallel for schedule(static) num_threads(team())
   for (std::size_t i = 0; i < n; ++i) {
     const int b = d_.body[i];
     const double w = b_.omega[b];
     const double ux = b_.vx[b] - w * d_.wy[i], uy = b_.vy[b] + w * d_.wx[i];
     const double u = std::sqrt(ux * ux + uy * uy);
     speed_[i] = u == u ? u : 0.0;  // (a NaN velocity: the list build refuses its position anyway)
+    half_skin_[i] = speed_[i];
   }
-  half_skin_.assign(speed_.begin(), speed_.end());
   const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(n - 1));
   std::nth_element(half_skin_.begin(), half_skin_.begin() + k, half_skin_.end());
   const double uq = half_skin_[static_cast<std::size_t>(k)];
   const double cap = EngineParams::kMaxSkinFactor * h0;
-  bool wider = false;
+  int wider = 0;
+#pragma omp parallel for schedule(static) num_threads(team()) reduction(| : wider)
   for (std::size_t i = 0; i < n; ++i) {
     // u_i tau = h0 u_i / u_q, compared as u_i > u_q first (uq may be 0: a settled state)
     const double h = speed_[i] > uq ? std::min(cap, h0 * (speed_[i] / uq)) : h0;
     half_skin_[i] = h;
-    wider = wider || h > h0;
+    wider |= h > h0 ? 1 : 0;
   }
   if (!wider) half_skin_.clear();
 }
@@ -398,8 +410,6 @@ void Simulation::update_thread_split() {
   split_builds_ = nlist_.builds();
   split_threads_ = nt;
   entry_row_.resize(nlist_.pair_count());
-  for (int i = 0; i < n; ++i)
-    std::fill(entry_row_.begin() + nlist_.row_start_[i], entry_row_.begin() + nlist_.row_start_[i + 1], i);
   split_.assign(nt + 1, 0);
   const auto& rs = nlist_.row_start_;
   const double per = static_cast<double>(nlist_.pair_count()) / nt;
@@ -411,12 +421,20 @@ void Simulation::update_thread_split() {
   split_[nt] = n;
   touch_blocks_ = (n >> kTouchShift) + 1;
   part_touch_.assign(static_cast<std::size_t>(nt) * touch_blocks_, 0);
-  for (int t = 0; t < nt; ++t) {
-    std::uint8_t* m = part_touch_.data() + static_cast<std::size_t>(t) * touch_blocks_;
-    if (split_[t] < split_[t + 1])
-      std::fill(m + (split_[t] >> kTouchShift), m + ((split_[t + 1] - 1) >> kTouchShift) + 1, 1);
-    if (nt > 1)
-      for (int e = rs[split_[t]]; e < rs[split_[t + 1]]; ++e) m[nlist_.nbr_[e] >> kTouchShift] = 1;
+  // Each part's entries' rows and its blocks, on the engine's threads (part u by thread u mod
+  // T; after a list build, serial time here is time the other threads wait).
+  int* er = entry_row_.data();
+#pragma omp parallel num_threads(team())
+  {
+    const int team_size = omp_get_num_threads();
+    for (int t = omp_get_thread_num(); t < nt; t += team_size) {
+      for (int i = split_[t]; i < split_[t + 1]; ++i) std::fill(er + rs[i], er + rs[i + 1], i);
+      std::uint8_t* m = part_touch_.data() + static_cast<std::size_t>(t) * touch_blocks_;
+      if (split_[t] < split_[t + 1])
+        std::fill(m + (split_[t] >> kTouchShift), m + ((split_[t + 1] - 1) >> kTouchShift) + 1, 1);
+      if (nt > 1)
+        for (int e = rs[split_[t]]; e < rs[split_[t + 1]]; ++e) m[nlist_.nbr_[e] >> kTouchShift] = 1;
+    }
   }
 }
 
@@ -904,9 +922,11 @@ void Simulation::provider_forces(double kick_h) {
   for (std::size_t k = 0; k < np; ++k) {
     forces_[k]->set_running_threads(team());
     forces_[k]->set_hand_held(true);
+    forces_[k]->set_body_set_version(body_set_version_);
     forces_[k]->add(b_, d_, time_, prov_fx_[k], prov_fy_[k], prov_tq_[k]);
     held_[k] = forces_[k]->held();
-    forces_[k]->set_hand_held(false);  // (a direct call of add() elsewhere adds everything)
+    forces_[k]->set_hand_held(false);  // (a direct call of add() elsewhere adds everything
+    forces_[k]->set_body_set_version(0);  // and compares what it holds)
     if (held_[k].terms < 0 || held_[k].terms > BodyForce::Held::kMaxTerms)
       throw std::logic_error(fmt::format("force provider {}: {} held terms", forces_[k]->name(), held_[k].terms));
   }

@@ -85,10 +85,17 @@ class BodyForce {
   virtual Held held() const { return {}; }
   bool hand_held() const { return hand_held_; }
   void set_hand_held(bool on) { hand_held_ = on; }
+  // A number the engine changes whenever its bodies are added, removed or reordered (unique in
+  // the process, never 0), set before add() and 0 after it; 0 = unknown (a direct call). A
+  // provider that keeps values per body may take an unchanged number for an unchanged body set
+  // instead of comparing the ids at every call.
+  std::uint64_t body_set_version() const { return body_set_version_; }
+  void set_body_set_version(std::uint64_t v) { body_set_version_ = v; }
 
  private:
   int running_threads_ = 0;
   bool hand_held_ = false;
+  std::uint64_t body_set_version_ = 0;
 };
 
 struct EngineParams {
@@ -256,6 +263,9 @@ class Simulation {
   std::vector<int> old_of_new_;  // disc renumbering since the last list build
   std::vector<double> half_skin_, speed_;  // per disc: skin of its own [m], speed (scratch) [m/s]
   bool structure_changed_ = true;
+  // Bodies added, removed or reordered: structure_changed_, and a new body_set_version_.
+  void body_set_changed();
+  std::uint64_t body_set_version_ = 0;
   bool forces_valid_ = false;
   std::vector<std::shared_ptr<BodyForce>> forces_;
   std::vector<std::vector<double>> prov_fx_, prov_fy_, prov_tq_;

@@ -101,7 +101,11 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
                       std::span<double>) {
   const std::size_t n = b.x.size();
   // Held forces belong to bodies by id; any change of the body set forces a fresh evaluation.
-  const bool same = ids_.size() == n && std::equal(ids_.begin(), ids_.end(), b.id.begin());
+  // (The engine's body-set number, unchanged since the last call, saves comparing the ids.)
+  const std::uint64_t version = body_set_version();
+  const bool same = ids_.size() == n && ((version != 0 && version == seen_version_) ||
+                                         std::equal(ids_.begin(), ids_.end(), b.id.begin()));
+  seen_version_ = version;
   if (!same || calls_ % cfg_.field_interval == 0) field_pass(b);
   if (cfg_.dipole_dipole && (!same || calls_ % cfg_.dipole_interval == 0)) dipole_pass(b, same);
   if (!same) ids_.assign(b.id.begin(), b.id.end());
@@ -213,6 +217,7 @@ void require_finite_all(const char* provider, const std::vector<double>& v, cons
 // Everything read is checked before use (docs/reliability.md): the held forces are indexed by
 // body in add() whenever the ids match, so their sizes must match the ids they belong to.
 void MagnetForce::load(std::istream& in) {
+  seen_version_ = 0;  // (the ids are compared at the next call)
   get(in, calls_); get_vec(in, ids_, "magnet ids"); get_vec(in, ffx_, "magnet fx"); get_vec(in, ffy_, "magnet fy");
   get_vec(in, dfx_, "dipole fx"); get_vec(in, dfy_, "dipole fy"); get_vec(in, moment_, "magnet moments");
   const char* who = "magnetic";
@@ -240,6 +245,7 @@ void ElectricForce::save(std::ostream& o) const {
 }
 void ElectricForce::load(std::istream& in) {
   get(in, calls_); get(in, t_last_); get(in, v_drum_); get(in, n_printable_);
+  seen_version_ = 0;  // (the ids are compared at the next call)
   get_vec(in, u_, "voltages"); get_vec(in, ids_, "electric ids"); get_vec(in, coupling_, "couplings");
   get_vec(in, printable_, "printable flags"); get_vec(in, near_disc_, "nearest discs"); get_vec(in, gap_, "gaps");
   get_vec(in, r_path_, "path resistances");
@@ -351,8 +357,12 @@ void ElectricForce::add(const BodyStore& b, const DiscStore& d, double t, std::s
                         std::span<double> torque) {
   const std::size_t nb = b.x.size();
   // Keep the charges with their bodies when bodies were added or removed.
+  // (The engine's body-set number, unchanged since the last call, saves comparing the ids.)
+  const std::uint64_t version = body_set_version();
   bool same = ids_.size() == nb;
-  if (same) for (std::size_t i = 0; i < nb && same; ++i) same = ids_[i] == b.id[i];
+  if (same && !(version != 0 && version == seen_version_))
+    for (std::size_t i = 0; i < nb && same; ++i) same = ids_[i] == b.id[i];
+  seen_version_ = version;
   if (!same) {
     std::unordered_map<std::int64_t, double> old;
     for (std::size_t i = 0; i < ids_.size() && i < u_.size(); ++i) old[ids_[i]] = u_[i];

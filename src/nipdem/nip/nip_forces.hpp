@@ -91,6 +91,7 @@ class MagnetForce final : public engine::BodyForce {
   std::vector<Vec2> moment_;
   std::vector<double> dfx_, dfy_;
   std::vector<std::int64_t> ids_;         // body ids the held forces belong to
+  std::uint64_t seen_version_ = 0;        // the engine's body-set number at the last call (0: none)
   std::vector<double> ffx_, ffy_;         // held magnet-field force per body [N]
   long calls_ = 0;
   dipole::PairSum pairs_;                 // persistent pair list (not saved: rebuilt after load)
@@ -140,6 +141,7 @@ class ElectricForce final : public engine::BodyForce {
   conduction::ConductionPaths paths_;
   std::vector<double> u_;                   // per body
   std::vector<std::int64_t> ids_;           // body ids u_ belongs to
+  std::uint64_t seen_version_ = 0;          // the engine's body-set number at the last call (0: none)
   std::vector<charge::DrumCoupling> coupling_;
   std::vector<char> printable_;
   std::vector<int> near_disc_;              // disc of each body nearest the drum
