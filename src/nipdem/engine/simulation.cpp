@@ -605,7 +605,12 @@ void Simulation::contact_forces(double kick_h, bool packed) {
   // mask bit each). Each disc's bits start cleared, so a disc without candidates has none.
   const bool near_walls = has_walls && list_mode == 2 && walls_.size() <= 32;
   const bool take_near = has_walls && list_mode == 1 && walls_.size() <= 32;
-  if (take_near) wall_near_.assign(static_cast<std::size_t>(n), 0u);
+  if (take_near) wall_near_.resize(static_cast<std::size_t>(n));  // (each disc's bits set in the region)
+  // The sublist's reference positions, copied per block in the region (not by one thread after it)
+  if (list_mode == 1) {
+    sub_x0_.resize(static_cast<std::size_t>(n));
+    sub_y0_.resize(static_cast<std::size_t>(n));
+  }
   int unused_n = 0;
   auto run_rows = [&]<bool A, bool Per>(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sn) {
     if (list_mode == 2) pair_rows<A, Per, 2>(i0, i1, f, nc, sub, sn);
@@ -700,6 +705,7 @@ void Simulation::contact_forces(double kick_h, bool packed) {
         // Walls: the candidates of the list build, or while the sublist is in use only those
         // within reach + margin when it was taken (most discs: none, no call).
         const std::uint32_t wm = !has_walls ? 0u : near_walls ? wall_near_[i] : wall_mask_[i];
+        if (take_near) wall_near_[i] = 0u;
         if (wm != 0) {
           try {  // the hit lists grow on first use (bad_alloc); rethrown after the region
             wall_disc(static_cast<std::size_t>(i), wm, thread_hits_[t].v, wall_nc);
@@ -710,6 +716,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
             if (!thread_fail_[t]) thread_fail_[t] = std::current_exception();
           }
         }
+      }
+      if (list_mode == 1) {
+        std::copy(d_.x.begin() + k0, d_.x.begin() + k1, sub_x0_.begin() + k0);
+        std::copy(d_.y.begin() + k0, d_.y.begin() + k1, sub_y0_.begin() + k0);
       }
       if (simple_blocks && simple_prefix_[c1] - simple_prefix_[c0] == c1 - c0) {
         // One disc per body at its centre (step()): reduce_body's sums with its offset (0, 0),
@@ -748,8 +758,6 @@ void Simulation::contact_forces(double kick_h, bool packed) {
   for (auto c : thread_nc_) total += c;
   n_contacts_ = total;
   if (list_mode == 1) {
-    sub_x0_.assign(d_.x.begin(), d_.x.end());
-    sub_y0_.assign(d_.y.begin(), d_.y.end());
     sub_builds_ = nlist_.builds();
     sub_threads_ = nt;
     sub_reach_ = pair_reach_;

@@ -49,13 +49,19 @@ magnet::Sample MagnetForce::sample(const Tile* t, Vec2 p) const {
   return t->map->at(p);
 }
 
-const MagnetForce::Tile* MagnetForce::tile_for(Vec2 p) {
-  if (!tabulate_) return nullptr;
+int MagnetForce::tile_index(Vec2 p) const {
+  if (!tabulate_) return -1;
   constexpr double T = kTileH * kTileCells;
   const double fx = std::floor(p.x / T) + kTilesX / 2, fy = std::floor(p.y / T) + kTilesY / 2;
-  if (!(fx >= 0.0 && fx < kTilesX && fy >= 0.0 && fy < kTilesY)) return nullptr;  // also NaN
-  const int tx = static_cast<int>(fx), ty = static_cast<int>(fy);
-  auto& tile = tiles_[static_cast<std::size_t>(ty) * kTilesX + tx];
+  if (!(fx >= 0.0 && fx < kTilesX && fy >= 0.0 && fy < kTilesY)) return -1;  // also NaN
+  return static_cast<int>(fy) * kTilesX + static_cast<int>(fx);
+}
+
+const MagnetForce::Tile* MagnetForce::tile_for(Vec2 p) {
+  const int k = tile_index(p);
+  if (k < 0) return nullptr;
+  const int tx = k % kTilesX, ty = k / kTilesX;
+  auto& tile = tiles_[static_cast<std::size_t>(k)];
   if (!tile) {
     // Nodes at integer multiples of h, two beyond the tile on each side so every node used
     // inside the tile has central 4th-order derivatives: the tile's values depend only on
@@ -154,29 +160,51 @@ void MagnetForce::field_pass(const BodyStore& b) {
     }
     return;
   }
-  // Tiles are built serially first; the parallel loop only reads them. Each particle is
-  // independent, so the result does not depend on the thread count.
-  for (std::size_t i = 0; i < n; ++i) tile_for({b.x[i], b.y[i]});
+  // The parallel loop only reads the tiles: a particle whose tile is not built yet is marked
+  // and evaluated after the loop, on one thread, which builds its tile (a tile is built once;
+  // a pass over every particle first to build them was time the other threads waited). Each
+  // particle is independent and a tile's values do not depend on when it is built, so the
+  // result does not depend on the thread count.
   // No exception may leave an OpenMP region (it would end the program): a failure (e.g. a field
   // map asked outside its range, InputError) is caught per particle and the one of the lowest
   // index rethrown after the loop, so any thread count reports the same error as one thread.
   std::size_t first_bad = n;
   std::exception_ptr error;
+  pending_.resize(n);
+  int any_pending = 0;
+  auto evaluate = [&](std::size_t i, const Tile* t) {
+    const Vec2 p{b.x[i], b.y[i]};
+    const magnet::Sample s = sample(t, p);
+    moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
+    const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
+    ffx_[i] = f.x;
+    ffy_[i] = f.y;
+  };
   const int run = running_threads() > 0 ? std::min(running_threads(), nt) : nt;  // the engine's choice (same results)
-#pragma omp parallel for schedule(static) num_threads(run)
+#pragma omp parallel for schedule(static) num_threads(run) reduction(| : any_pending)
   for (std::size_t i = 0; i < n; ++i) {
+    const int k = tile_index({b.x[i], b.y[i]});
+    const bool missing = k >= 0 && !tiles_[static_cast<std::size_t>(k)];
+    pending_[i] = missing ? 1 : 0;
+    any_pending |= missing ? 1 : 0;
+    if (missing) continue;
     try {
-      const Vec2 p{b.x[i], b.y[i]};
-      const magnet::Sample s = sample(tile_for(p), p);  // the tile exists now: no write
-      moment_[i] = magnet::induced_moment(cfg_.toner, 0.5 * b.size[i], s.B);  // eq. 4.5.1
-      const Vec2 f = magnet::dipole_force(moment_[i], s);                      // eq. 2.4.34
-      ffx_[i] = f.x;
-      ffy_[i] = f.y;
+      evaluate(i, k >= 0 ? tiles_[static_cast<std::size_t>(k)].get() : nullptr);
     } catch (...) {
 #pragma omp critical(nipdem_magnet_field_pass_error)
       if (i < first_bad) { first_bad = i; error = std::current_exception(); }
     }
   }
+  if (any_pending)
+    for (std::size_t i = 0; i < n && i < first_bad; ++i) {
+      if (!pending_[i]) continue;
+      try {
+        evaluate(i, tile_for({b.x[i], b.y[i]}));
+      } catch (...) {
+        first_bad = i;
+        error = std::current_exception();
+      }
+    }
   if (error) std::rethrow_exception(error);
 }
 

@@ -79,6 +79,7 @@ class MagnetForce final : public engine::BodyForce {
   };
   magnet::Sample field_at(Vec2 p);
   const Tile* tile_for(Vec2 p);  // builds the tile if needed; null = outside the table: use field_
+  int tile_index(Vec2 p) const;  // index of p's tile in tiles_, -1 outside the table (or none)
   magnet::Sample sample(const Tile* t, Vec2 p) const;
   std::shared_ptr<const magnet::MagnetField> field_;
   // Tabulated field: tiles_[ty * kTilesX + tx] covers [x_lo + tx T, x_lo + (tx+1) T) x (same in y).
@@ -92,6 +93,7 @@ class MagnetForce final : public engine::BodyForce {
   std::vector<double> dfx_, dfy_;
   std::vector<std::int64_t> ids_;         // body ids the held forces belong to
   std::uint64_t seen_version_ = 0;        // the engine's body-set number at the last call (0: none)
+  std::vector<char> pending_;             // field_pass: particles whose tile was not built yet
   std::vector<double> ffx_, ffy_;         // held magnet-field force per body [N]
   long calls_ = 0;
   dipole::PairSum pairs_;                 // persistent pair list (not saved: rebuilt after load)
