@@ -274,29 +274,60 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   } catch (...) {
     failure[static_cast<std::size_t>(omp_get_thread_num())] = std::current_exception();
   }
-  }
-  for (const auto& e : failure)
-    if (e) std::rethrow_exception(e);
-  for (std::size_t i = 0; i < n; ++i) new_start_[i + 1] += new_start_[i];
-  new_nbr_.resize(new_start_[n]);
-  new_eta_.resize(new_start_[n]);
-  new_slide_.resize(new_start_[n]);
-  for (int t = 0, off = 0; t < nt; ++t) {
+  // Joined in the region: the arrays sized by one thread, then each thread writes its own rows'
+  // offsets, entries and reference positions (one thread doing it after the region was time
+  // the others waited, at every list build). Nothing is written unless every part succeeded.
+#pragma omp barrier
+#pragma omp single
+  {
+    try {
+      join_ok_ = true;
+      for (const auto& e : failure) join_ok_ = join_ok_ && !e;
+      if (join_ok_) {
+        const int T = omp_get_num_threads();
+        part_off_.assign(static_cast<std::size_t>(T) + 1, 0);
+        for (int t = 0; t < T; ++t) part_off_[t + 1] = part_off_[t] + static_cast<int>(rows_[t].nbr.size());
+        const auto total = static_cast<std::size_t>(part_off_[T]);
+        new_nbr_.resize(total);
+        new_eta_.resize(total);
+        new_slide_.resize(total);
+        x0_.resize(n);
+        y0_.resize(n);
+        h_.resize(half_skin.size());
+        inv_h2_.resize(half_skin.size());
+      }
+    } catch (...) {
+      join_ok_ = false;
+      failure[0] = std::current_exception();
+    }
+  }  // (implicit barrier)
+  if (join_ok_) {
+    const int T = omp_get_num_threads(), t = omp_get_thread_num();
+    const std::size_t i_lo = n * t / T, i_hi = n * (t + 1) / T;
     const Rows& part = rows_[t];
+    const int off = part_off_[t];
     std::copy(part.nbr.begin(), part.nbr.end(), new_nbr_.begin() + off);
     std::copy(part.eta.begin(), part.eta.end(), new_eta_.begin() + off);
     std::copy(part.slide.begin(), part.slide.end(), new_slide_.begin() + off);
-    off += static_cast<int>(part.nbr.size());
+    for (std::size_t i = i_lo, at = static_cast<std::size_t>(off); i < i_hi; ++i) {
+      at += static_cast<std::size_t>(new_start_[i + 1]);
+      new_start_[i + 1] = static_cast<int>(at);
+    }
+    std::copy(x.begin() + i_lo, x.begin() + i_hi, x0_.begin() + i_lo);
+    std::copy(y.begin() + i_lo, y.begin() + i_hi, y0_.begin() + i_lo);
+    if (per_disc)
+      for (std::size_t i = i_lo; i < i_hi; ++i) {
+        h_[i] = half_skin[i];
+        inv_h2_[i] = 1.0 / (h_[i] * h_[i]);  // (h = 0: inf, rebuilt at every check)
+      }
   }
+  }
+  for (const auto& e : failure)
+    if (e) std::rethrow_exception(e);
   row_start_.swap(new_start_);
   nbr_.swap(new_nbr_);
   eta_.swap(new_eta_);
   slide_.swap(new_slide_);
-  x0_.assign(x.begin(), x.end());
-  y0_.assign(y.begin(), y.end());
-  h_.assign(half_skin.begin(), half_skin.end());
-  inv_h2_.resize(h_.size());
-  for (std::size_t i = 0; i < h_.size(); ++i) inv_h2_[i] = 1.0 / (h_[i] * h_[i]);  // (h = 0: inf, rebuilt at every check)
 }
 
 }  // namespace nipdem::geometry

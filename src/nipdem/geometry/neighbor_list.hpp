@@ -133,6 +133,8 @@ class NeighborList {
   std::vector<std::pair<int, int>> wide_pairs_;
   std::vector<int> wide_start_, wide_nbr_;
   std::vector<int> new_start_, new_nbr_;
+  std::vector<int> part_off_;  // where each thread's rows start in the joined list
+  bool join_ok_ = false;       // (shared by the build's threads)
   std::vector<double> new_eta_;
   std::vector<std::uint8_t> new_slide_;
   // One thread's consecutive rows during a build. On cache lines of its own: the vectors' ends
