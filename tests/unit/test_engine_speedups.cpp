@@ -907,3 +907,34 @@ TEST(BodyOrder, ABadPermutationIsRefusedAndChangesNothing) {
   EXPECT_THROW(a.sort_bodies_spatially(0.0), InputError);
   EXPECT_THROW(a.sort_bodies_spatially(std::nan("")), InputError);
 }
+
+// The sublist's margins per disc are made once per list build (not at each take of the
+// sublist): at every take they are those of the list in use, g_i = inner_skin_fraction x h_i,
+// across list builds whose skins per disc differ (clusters raining onto a floor at 1-4 m/s,
+// skins from the speed quantile).
+TEST(SublistMargins, AtEveryTakeTheyAreThoseOfTheListInUse) {
+  EngineParams p = floor_box_params(140e-6, 1, 1);
+  Simulation sim(p, {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+  add_cluster_grid(sim, 10, 17);
+  int takes = sim.pair_sublist_builds(), checked = 0, builds_seen = 0, last_build = -1;
+  std::vector<double> first_margins;
+  bool margins_changed = false;
+  for (int s = 0; s < 3000; ++s) {
+    sim.step();
+    if (sim.pair_sublist_builds() == takes) continue;
+    takes = sim.pair_sublist_builds();
+    const auto& nl = sim.neighbor_list();
+    const auto& g = sim.pair_sublist_margins();
+    if (!nl.per_disc()) continue;
+    ASSERT_EQ(g.size(), nl.size());
+    for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(g[i], p.inner_skin_fraction * nl.max_move(i)) << "disc " << i << " step " << s;
+    ++checked;
+    if (nl.builds() != last_build) { ++builds_seen; last_build = nl.builds(); }
+    if (first_margins.empty()) first_margins = g;
+    else margins_changed = margins_changed || g != first_margins;
+  }
+  // the test saw takes across several list builds with different skins
+  EXPECT_GT(checked, 20);
+  EXPECT_GT(builds_seen, 3);
+  EXPECT_TRUE(margins_changed);
+}

@@ -581,7 +581,10 @@ void Simulation::contact_forces(double kick_h, bool packed) {
       sub_margin_ = margin;
       // With skins per disc, margins per disc: the same fraction of each disc's own skin.
       sub_per_disc_ = nlist_.per_disc() && nlist_.size() == static_cast<std::size_t>(n);
-      if (sub_per_disc_) {
+      // (They depend only on the list's skins: made again only after a list build, not at each
+      // take of the sublist, where one thread made them while the others waited.)
+      if (sub_per_disc_ && (sub_g_builds_ != nlist_.builds() || sub_g_fraction_ != params_.inner_skin_fraction ||
+                            sub_g_.size() != static_cast<std::size_t>(n))) {
         sub_g_.resize(static_cast<std::size_t>(n));
         sub_w_.resize(static_cast<std::size_t>(n));
         for (std::size_t i = 0; i < static_cast<std::size_t>(n); ++i) {
@@ -589,6 +592,8 @@ void Simulation::contact_forces(double kick_h, bool packed) {
           sub_g_[i] = g;
           sub_w_[i] = 1.0 / (0.99 * g * 0.99 * g);
         }
+        sub_g_builds_ = nlist_.builds();
+        sub_g_fraction_ = params_.inner_skin_fraction;
       }
       sub_.resize(nt);
       sub_n_.assign(nt, 0);

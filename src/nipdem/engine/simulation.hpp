@@ -200,6 +200,9 @@ class Simulation {
   const geometry::NeighborList& neighbor_list() const { return nlist_; }
   // How often the pair kernel's per-step sublist was taken (EngineParams::inner_skin_fraction).
   int pair_sublist_builds() const { return sub_takes_; }
+  // The sublist's margins per disc, g_i = inner_skin_fraction x the disc's skin share (empty
+  // with one skin for all); for tests.
+  const std::vector<double>& pair_sublist_margins() const { return sub_g_; }
   const std::vector<std::shared_ptr<BodyForce>>& forces() const { return forces_; }
   // Per-provider force on each body from the last evaluation (for output) [N].
   const std::vector<double>& provider_fx(std::size_t k) const { return prov_fx_[k]; }
@@ -356,6 +359,8 @@ class Simulation {
   int list_room_ = -1;
   bool list_check_ = true;
   std::vector<double> sub_g_, sub_w_;  // per disc: margin g_i [m], 1 / (0.99 g_i)^2 [1/m^2]
+  int sub_g_builds_ = -1;              // the list build they were made for
+  double sub_g_fraction_ = 0.0;        // and the inner_skin_fraction
 };
 
 }  // namespace nipdem::engine
