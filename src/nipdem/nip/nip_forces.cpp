@@ -111,10 +111,11 @@ void MagnetForce::add(const BodyStore& b, const DiscStore&, double, std::span<do
   const std::uint64_t version = body_set_version();
   const bool same = ids_.size() == n && ((version != 0 && version == seen_version_) ||
                                          std::equal(ids_.begin(), ids_.end(), b.id.begin()));
-  seen_version_ = version;
+  seen_version_ = 0;  // (until the held forces belong to these bodies: a failed pass compares again)
   if (!same || calls_ % cfg_.field_interval == 0) field_pass(b);
   if (cfg_.dipole_dipole && (!same || calls_ % cfg_.dipole_interval == 0)) dipole_pass(b, same);
   if (!same) ids_.assign(b.id.begin(), b.id.end());
+  seen_version_ = version;
   ++calls_;
   if (hand_held()) return;  // the engine adds the held forces (held()) in its own pass
   // The held forces, added per body (the same sums for any thread count), on the engine's
