@@ -266,9 +266,10 @@ int main(int argc, char** argv) {
     ke_t += 0.5 * b.mass[i] * (b.vx[i] * b.vx[i] + b.vy[i] * b.vy[i]);
     ke_r += 0.5 * b.inertia[i] * b.omega[i] * b.omega[i];
   }
-  std::printf("  wall_time_s=%.3f cpu_time_s=%.3f disc_steps_per_s=%.4g (per cpu-second %.4g) neighbor_builds=%d pairs_in_list=%zu sublist_takes=%d\n",
+  std::printf("  wall_time_s=%.3f cpu_time_s=%.3f disc_steps_per_s=%.4g (per cpu-second %.4g) neighbor_builds=%d pairs_in_list=%zu sublist_takes=%d cross_part_entries=%lld\n",
               wall, cpu, rate, static_cast<double>(n) * static_cast<double>(steps) / cpu,
-              sim.neighbor_list().builds() - builds0, sim.neighbor_list().pair_count(), sim.pair_sublist_builds() - takes0);
+              sim.neighbor_list().builds() - builds0, sim.neighbor_list().pair_count(), sim.pair_sublist_builds() - takes0,
+              static_cast<long long>(sim.pair_cross_entries()));
   std::printf("  final: ke_translational_J=%.6g ke_rotational_J=%.6g contacts_per_disc=%.4f (disc-disc, as "
               "LAMMPS contact/atom) all_contacts=%lld\n",
               ke_t, ke_r, contacts_per_disc(sim), static_cast<long long>(sim.contacts()));

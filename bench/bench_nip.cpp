@@ -59,6 +59,7 @@ struct Result {
   int builds = 0;
   int sublist_takes = 0;          // the pair kernel's per-step sublist taken (EngineParams::inner_skin_fraction)
   std::size_t listed_pairs = 0;   // pairs in the contact list at the end
+  long long cross_entries = 0;    // of those, partners in a later part than their row (Simulation::pair_cross_entries)
   long maxrss_kb = 0;
   int threads_running = 1, thread_switches = 0;  // the engine's thread choice at the end (engine/team_tuner.hpp)
 };
@@ -387,6 +388,7 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
   r.builds = sim.neighbor_list().builds() - builds0;
   r.sublist_takes = sim.pair_sublist_builds() - takes0;
   r.listed_pairs = sim.neighbor_list().pair_count();
+  r.cross_entries = static_cast<long long>(sim.pair_cross_entries());
   const auto t1 = std::chrono::steady_clock::now();
   r.cpu_s = cpu_seconds() - c0;
   r.wall_s = std::chrono::duration<double>(t1 - t0).count();
@@ -410,9 +412,9 @@ Result run(std::vector<std::string> overrides, const State* start, long settle, 
 void print(const char* label, const Result& r, long steps) {
   std::printf("  %-28s particles=%zu discs=%zu wall=%.3f s cpu=%.3f s disc_steps_per_s=%.4g "
               "wall_per_simulated_ms=%.2f s contacts_per_disc=%.3f coordination_disc=%.2f coordination_body=%.2f list_builds=%d "
-              "sublist_takes=%d listed_pairs=%zu peak_rss=%.1f MB magnet_share=%.1f %% dipole_list_builds=%d dipole_listed_pairs=%zu threads_running=%d thread_switches=%d\n",
+              "sublist_takes=%d listed_pairs=%zu cross_part_entries=%lld peak_rss=%.1f MB magnet_share=%.1f %% dipole_list_builds=%d dipole_listed_pairs=%zu threads_running=%d thread_switches=%d\n",
               label, r.bodies, r.discs, r.wall_s, r.cpu_s, r.rate, r.wall_s / (r.sim_s * 1e3), r.contacts_per_disc, r.z_disc, r.z_body,
-              r.builds, r.sublist_takes, r.listed_pairs, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s, r.dipole_builds, r.dipole_pairs, r.threads_running,
+              r.builds, r.sublist_takes, r.listed_pairs, r.cross_entries, r.maxrss_kb / 1024.0, 100.0 * r.magnet_s / r.wall_s, r.dipole_builds, r.dipole_pairs, r.threads_running,
               r.thread_switches);
   (void)steps;
 }

@@ -203,6 +203,9 @@ class Simulation {
   // The sublist's margins per disc, g_i = inner_skin_fraction x the disc's skin share (empty
   // with one skin for all); for tests.
   const std::vector<double>& pair_sublist_margins() const { return sub_g_; }
+  // List entries whose partner lies in a later part than their row (their forces go through the
+  // cross slots), for the list and part split of the last force evaluation; 0 with one part.
+  std::int64_t pair_cross_entries() const { return cross_count_; }
   const std::vector<std::shared_ptr<BodyForce>>& forces() const { return forces_; }
   // Per-provider force on each body from the last evaluation (for output) [N].
   const std::vector<double>& provider_fx(std::size_t k) const { return prov_fx_[k]; }
@@ -251,10 +254,13 @@ class Simulation {
   struct alignas(32) PackedForce { double fx, fy, tq, pad; };
   // One entry of the per-step sublist: the Verlet list entry and its two discs.
   struct SubEntry { int e, i, j; };
+  // kCross: rows before the last part's, whose partners from i1 on go to their cross slots.
   // kList: 0 = test every entry of rows [i0, i1); 1 = the same, and take the sublist of those
   // rows into sub/sub_n; 2 = test only the sublist sub[0, sub_n).
-  template <bool kAdhesion, bool kPeriodic, int kList>
+  template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
   void pair_rows(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sub_n);
+  // The pair sums of discs [k0, k1) (a block of bodies) into d_.fx/fy/tq, the buffers cleared.
+  void reduce_pair_sums(int k0, int k1);
   bool sublist_moved() const;  // two largest displacements since the sublist exceed its margin
 
   EngineParams params_;
@@ -275,18 +281,30 @@ class Simulation {
   std::vector<BodyForce::Held> held_;  // per provider, the held terms of its last add()
   std::vector<PackedDisc> pdisc_;
   std::vector<PackedVel> pvel_;
-  std::vector<std::vector<PackedForce>> tforce_;  // per-thread pair-force buffers
+  // Pair-force sums per disc, one buffer for all parts: a part writes only its own discs there.
+  std::vector<PackedForce> pforce_;
   // contact_forces()' per-body phase: blocks of kBodyBlock bodies, shared out by stealing
   static constexpr int kBodyBlock = 256;
   BlockSteal body_blocks_;
-  // Thread t owns list rows [split_[t], split_[t+1]) and writes its own discs and their listed
-  // partners (j > i, which may lie anywhere after split_[t+1]: across a periodic seam, the far
-  // end of the order). part_touch_[t * touch_blocks_ + (i >> kTouchShift)] is 1 if it may write
-  // disc i: only those blocks of its buffer are read and zeroed.
+  // Part t (of EngineParams::threads) owns list rows [split_[t], split_[t+1]) and writes its own
+  // discs. A listed partner beyond its rows (j >= split_[t+1]: the next part, or across a
+  // periodic seam the far end of the order) is a cross entry: its force on j goes into a slot of
+  // its own (cross_val_[cross_slot_[e]]), and the per-body phase sums the slots of disc j per
+  // part in entry order, parts in order, then adds j's own part's sum: the same operations in the
+  // same order as when each part had a buffer of all discs (one thread running several parts
+  // reads one buffer, not one per part). Part t's slots are [rs[split_[t]], +its cross count),
+  // sorted by the block of 2^kTouchShift discs their disc is in (entry order within a block);
+  // cross_block_[t * (touch_blocks_ + 2) + b] is the first slot of block b. Every slot is zero
+  // between steps (the per-body phase clears what it reads).
+  struct CrossForce { double fx, fy, tq; };
   static constexpr int kTouchShift = 6;
   std::vector<int> split_;
-  std::vector<std::uint8_t> part_touch_;
   int touch_blocks_ = 0;
+  std::vector<int> cross_slot_;         // per list entry: its slot, if a cross entry
+  std::vector<int> cross_disc_;         // per slot: the disc j it acts on
+  std::vector<CrossForce> cross_val_;   // per slot: the pair's force on i (fx, fy) and torque on j
+  std::vector<int> cross_block_;        // per part: block offsets into its slots
+  std::int64_t cross_count_ = 0;        // cross entries of the list in use (all parts)
   std::vector<int> entry_row_;  // the list row (disc i) of each list entry, for the flat pair loop
   std::vector<std::int64_t> thread_nc_;
   std::vector<double> inv_mass_, inv_inertia_, dtheta_;  // per body, 1/m, 1/I and the rotation of this step (scratch of step())
