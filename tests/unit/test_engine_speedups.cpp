@@ -432,9 +432,9 @@ TEST(TeamTuner, ResultsDoNotDependOnHowManyThreadsRun) {
   EXPECT_TRUE(one == measured);
 }
 
-// Each part of the pair rows writes its own discs and their listed partners, which across a
-// periodic seam lie at the far end of the disc order; only the blocks a part may write are
-// read and cleared in the reduction (part_touch_). Disc 0 (x = 2.8 um) and the last disc (x =
+// Each part of the pair rows writes its own discs, and its listed partners beyond its rows
+// (across a periodic seam at the far end of the disc order) through cross slots read in the
+// per-body phase by the block of the disc they act on. Disc 0 (x = 2.8 um) and the last disc (x =
 // 197.1 um) touch across the seam of a 200 um box; 72 pairs of touching discs in between (rows
 // above) give the second part rows of its own, so the last disc lies in it, two blocks of 64
 // discs past the first part's own rows, while its only force comes from the first part's row

@@ -679,8 +679,8 @@ inline void Simulation::reduce_pair_sums(int k0, int k1) {
 }
 
 // Pair forces, wall forces and their sum per body, in one parallel region: pack the discs
-// (unless step() has), run the pair kernel on each thread's rows, reduce the thread buffers per
-// disc and add the wall forces of that disc, then sum per body (and, with kick_h > 0, kick it:
+// (unless step() has), run the pair kernel on each part's rows, gather each disc's pair sums
+// (reduce_pair_sums) and add the wall forces of that disc, then sum per body (and, with kick_h > 0, kick it:
 // step()).
 void Simulation::contact_forces(double kick_h, bool packed) {
   const int n = static_cast<int>(d_.x.size());

@@ -4,9 +4,10 @@
 //
 // Design notes
 //  - Forces are accumulated per disc (force + torque about the disc centre) in one pair loop
-//    over a half Verlet list, then reduced per body. With OpenMP each thread owns a static
-//    range of rows and its own force buffer; buffers are summed in thread order, so a run is
-//    bitwise reproducible for a given thread count.
+//    over a half Verlet list, then reduced per body. The rows are split into
+//    EngineParams::threads parts; a part writes its own discs, and its forces on partners in
+//    later parts go to slots of their own, summed per part in part order: a run is bitwise
+//    reproducible for a given part count, however many threads run the parts.
 //  - A pair contributes nothing unless it interacts, and history is reset the moment a
 //    contact opens, so results do not depend on when the neighbour list was rebuilt: this
 //    is what makes checkpoint/resume bitwise exact. The same holds for the pair kernel's
