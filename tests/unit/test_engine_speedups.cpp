@@ -484,28 +484,41 @@ TEST(PartBuffers, APartnerAcrossThePeriodicSeamIsSummed) {
 // rounding, so the velocities agree to 1e-9 of the largest (a part's slots read at the wrong
 // place, as a first version did for parts after the first, left 2x the kinetic energy after 100
 // steps of the packing benchmark). Every split has cross entries, and the run has contacts.
+// Run twice: with the bodies in the grid's order (a part's cross entries reach the next part
+// only) and in an order shuffled the same way for every part count (discs reached by several
+// earlier parts in one block, the per-body phase's general case).
 TEST(PartBuffers, EveryPartCountSumsTheSameForces) {
-  std::vector<std::vector<double>> v;
-  for (int parts = 1; parts <= 4; ++parts) {
-    Simulation sim(floor_box_params(200e-6, 1, 1), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
-    add_cluster_grid(sim, 14, 11);
-    for (int k = 0; k < 2000; ++k) sim.step();
-    sim.mutable_params().threads = parts;
-    sim.mutable_params().run_threads = parts;
-    for (int k = 0; k < 40; ++k) sim.step();
-    EXPECT_GT(sim.contacts(), 10);
-    if (parts > 1) EXPECT_GT(sim.pair_cross_entries(), 0) << parts << " parts";
-    std::vector<double> w = sim.bodies().vx;
-    w.insert(w.end(), sim.bodies().vy.begin(), sim.bodies().vy.end());
-    v.push_back(std::move(w));
-  }
-  double vmax = 0.0;
-  for (double x : v[0]) vmax = std::max(vmax, std::fabs(x));
-  ASSERT_GT(vmax, 0.1);
-  for (int parts = 2; parts <= 4; ++parts) {
-    double worst = 0.0;
-    for (std::size_t k = 0; k < v[0].size(); ++k) worst = std::max(worst, std::fabs(v[parts - 1][k] - v[0][k]));
-    EXPECT_LT(worst, 1e-9 * vmax) << parts << " parts";
+  for (const bool shuffled : {false, true}) {
+    std::vector<std::vector<double>> v;
+    for (int parts = 1; parts <= 4; ++parts) {
+      Simulation sim(floor_box_params(200e-6, 1, 1), {test::plane_wall({0, 0}, {0, 1}, 1, "floor")});
+      add_cluster_grid(sim, 14, 11);
+      for (int k = 0; k < 2000; ++k) sim.step();
+      if (shuffled) {
+        std::vector<int> order(sim.bodies().x.size());
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+        Rng rng(5);
+        for (std::size_t k = order.size() - 1; k > 0; --k)
+          std::swap(order[k], order[static_cast<std::size_t>(rng.uniform(0.0, static_cast<double>(k + 1))) % (k + 1)]);
+        sim.permute_bodies(order);
+      }
+      sim.mutable_params().threads = parts;
+      sim.mutable_params().run_threads = parts;
+      for (int k = 0; k < 40; ++k) sim.step();
+      EXPECT_GT(sim.contacts(), 10);
+      if (parts > 1) EXPECT_GT(sim.pair_cross_entries(), 0) << parts << " parts";
+      std::vector<double> w = sim.bodies().vx;
+      w.insert(w.end(), sim.bodies().vy.begin(), sim.bodies().vy.end());
+      v.push_back(std::move(w));
+    }
+    double vmax = 0.0;
+    for (double x : v[0]) vmax = std::max(vmax, std::fabs(x));
+    ASSERT_GT(vmax, 0.1);
+    for (int parts = 2; parts <= 4; ++parts) {
+      double worst = 0.0;
+      for (std::size_t k = 0; k < v[0].size(); ++k) worst = std::max(worst, std::fabs(v[parts - 1][k] - v[0][k]));
+      EXPECT_LT(worst, 1e-9 * vmax) << parts << " parts" << (shuffled ? ", shuffled" : "");
+    }
   }
 }
 
