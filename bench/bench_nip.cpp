@@ -140,6 +140,7 @@ class TimedForce final : public engine::BodyForce {
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   Held held() const override { return f_->held(); }
+  bool reads_contacts() const override { return f_->reads_contacts(); }
   void save(std::ostream& o) const override { f_->save(o); }
   void load(std::istream& in) override { f_->load(in); }
   double seconds = 0.0;

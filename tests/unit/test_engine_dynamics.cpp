@@ -218,7 +218,7 @@ TEST(InclinedPlane, SingleDiscRollsWhereClusterDoesNot) {
 namespace {
 // Discs and 3-disc clusters in a box of four planes, random velocities.
 Simulation make_box(double e, bool friction, bool adhesion, Integrator integ, double dt_frac, std::uint64_t seed,
-                    int threads = 1) {
+                    int threads = 1, int tight = 0) {
   const double R = 2e-6, box = 40e-6;
   const double m = 1700 * 4.0 / 3.0 * kPi * R * R * R;
   EngineParams p;
@@ -239,7 +239,10 @@ Simulation make_box(double e, bool friction, bool adhesion, Integrator integ, do
   for (int iy = 0; iy < 5; ++iy)
     for (int ix = 0; ix < 5; ++ix) {
       const Vec2 pos{(ix + 0.5) * box / 5, (iy + 0.5) * box / 5};
-      BodySpec s = (placed % 2) ? triangle(R, pos, rng.uniform(0, 6.28)) : single(R * 1.2, pos);
+      // tight = 1: single discs that overlap their neighbours and the walls from the start;
+      // 2: those and triangles that reach them (contacts at every step)
+      const double rs = tight ? 0.5125 * box / 5 : R * 1.2, rt = tight ? 2.8e-6 : R;
+      BodySpec s = (placed % 2 && tight != 1) ? triangle(rt, pos, rng.uniform(0, 6.28)) : single(rs, pos);
       s.velocity = {rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05)};
       s.omega = rng.uniform(-1e4, 1e4);
       sim.add_body(s);
@@ -328,7 +331,9 @@ namespace {
 // engine (BodyForce::Held) when the engine offers.
 struct TwoTermHeld : BodyForce {
   bool take_up;
-  explicit TwoTermHeld(bool t) : take_up(t) {}
+  bool contacts = true;  // reads_contacts()
+  explicit TwoTermHeld(bool t, bool reads = true) : take_up(t), contacts(reads) {}
+  bool reads_contacts() const override { return contacts; }
   std::vector<double> ax, ay, bx, by;
   int calls = 0;
   std::string name() const override { return "two-term"; }
@@ -381,6 +386,45 @@ TEST(HeldForces, EngineAddsThemWithTheBitsAddWouldGive) {
     // and the offer ends with the engine's call: a direct add() adds everything
     EXPECT_FALSE(pb->hand_held());
   }
+}
+
+// Providers that read no contact state (BodyForce::reads_contacts() false) are called before the
+// contact forces, and their sums and the closing kick run in the contact forces' body phase:
+// the same operations in the same order as the provider loop after them, so the same bits in
+// the motion and in the provider's arrays. Both integrators, 1-3 threads, the body phase's
+// path for single-disc blocks and for blocks with clusters, a held provider and a direct one.
+TEST(HeldForces, ProvidersCalledBeforeTheContactForcesGiveTheSameBits) {
+  for (const Integrator integ : {Integrator::velocity_verlet, Integrator::newmark_explicit})
+    for (const int clusters : {0, 1})
+      for (int threads : {1, 2, 3}) {
+        SCOPED_TRACE(::testing::Message() << "integrator " << static_cast<int>(integ) << ", clusters " << clusters
+                                          << ", threads " << threads);
+        Simulation a = make_box(0.6, true, true, integ, 1.0 / 30, 5, threads, 1 + clusters);
+        Simulation b = make_box(0.6, true, true, integ, 1.0 / 30, 5, threads, 1 + clusters);
+        // a: after the contact forces (reads_contacts); b: before them
+        a.add_force(std::make_shared<TwoTermHeld>(true, true));
+        a.add_force(std::make_shared<TwoTermHeld>(false, true));
+        b.add_force(std::make_shared<TwoTermHeld>(true, false));
+        b.add_force(std::make_shared<TwoTermHeld>(false, false));
+        std::int64_t touched = 0;  // contacts summed over the steps: the contact forces took part
+        for (int i = 0; i < 400; ++i) { a.step(); b.step(); touched += a.contacts(); }
+        ASSERT_GT(touched, 0);
+        ASSERT_EQ(a.bodies().x.size(), b.bodies().x.size());
+        int differ = 0;
+        for (std::size_t i = 0; i < a.bodies().x.size(); ++i) {
+          differ += a.bodies().x[i] != b.bodies().x[i] || a.bodies().vx[i] != b.bodies().vx[i] ||
+                    a.bodies().vy[i] != b.bodies().vy[i] || a.bodies().omega[i] != b.bodies().omega[i] ||
+                    a.bodies().fx[i] != b.bodies().fx[i] || a.bodies().torque[i] != b.bodies().torque[i];
+          for (std::size_t k = 0; k < 2; ++k)
+            differ += a.provider_fx(k)[i] != b.provider_fx(k)[i] || a.provider_fy(k)[i] != b.provider_fy(k)[i] ||
+                      a.provider_torque(k)[i] != b.provider_torque(k)[i];
+        }
+        EXPECT_EQ(differ, 0);
+        // the providers' forces reached the motion: without them the bodies move otherwise
+        Simulation c = make_box(0.6, true, true, integ, 1.0 / 30, 5, threads, 1 + clusters);
+        for (int i = 0; i < 400; ++i) c.step();
+        EXPECT_NE(c.bodies().vx[3], b.bodies().vx[3]);
+      }
 }
 
 namespace {

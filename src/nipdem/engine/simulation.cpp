@@ -682,7 +682,7 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
 // (unless step() has), run the pair kernel on each part's rows, gather each disc's pair sums
 // (reduce_pair_sums) and add the wall forces of that disc, then sum per body (and, with kick_h > 0, kick it:
 // step()).
-void Simulation::contact_forces(double kick_h, bool packed) {
+void Simulation::contact_forces(double kick_h, bool packed, bool providers) {
   const int n = static_cast<int>(d_.x.size());
   const int nb = static_cast<int>(b_.x.size());
   const bool has_walls = !walls_.empty();
@@ -809,8 +809,9 @@ void Simulation::contact_forces(double kick_h, bool packed) {
     for (int q = body_blocks_.next(t); q >= 0; q = body_blocks_.next(t)) {
       const int c0 = q * kBodyBlock, c1 = std::min(nb, c0 + kBodyBlock);
       const int k0 = b_.first_disc[c0], k1 = c1 < nb ? b_.first_disc[c1] : n;
-      // the force providers' arrays, cleared for provider_forces() (which follows every call)
-      for (std::size_t k = 0; k < forces_.size(); ++k) {
+      // the force providers' arrays, cleared for provider_forces() (which follows every call
+      // without providers; with them, step() cleared them before calling the providers)
+      for (std::size_t k = 0; k < (providers ? 0 : forces_.size()); ++k) {
         std::fill(prov_fx_[k].begin() + c0, prov_fx_[k].begin() + c1, 0.0);
         std::fill(prov_fy_[k].begin() + c0, prov_fy_[k].begin() + c1, 0.0);
         std::fill(prov_tq_[k].begin() + c0, prov_tq_[k].begin() + c1, 0.0);
@@ -851,16 +852,19 @@ void Simulation::contact_forces(double kick_h, bool packed) {
           bfy[bb] = fy + m[bb] * g.y;
           btq[bb] = 0.0 + (dtq[bb] + 0.0 * dfy[bb] - 0.0 * dfx[bb]);
         }
+        if (providers) add_provider_forces(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1));
         if (kick_h > 0.0)
           for (int bb = c0; bb < c1; ++bb) {
             vx[bb] += kick_h * bfx[bb] * im[bb]; vy[bb] += kick_h * bfy[bb] * im[bb]; om[bb] += kick_h * btq[bb] * iI[bb];
           }
-      } else if (kick_h > 0.0) {
-        // The same operations as step()'s own kick loop, so the same bits.
-        for (int bb = c0; bb < c1; ++bb) {
-          reduce_body(static_cast<std::size_t>(bb));
-          vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
-        }
+      } else if (kick_h > 0.0 || providers) {
+        // The same operations as provider_forces()' loop, so the same bits.
+        for (int bb = c0; bb < c1; ++bb) reduce_body(static_cast<std::size_t>(bb));
+        if (providers) add_provider_forces(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1));
+        if (kick_h > 0.0)
+          for (int bb = c0; bb < c1; ++bb) {
+            vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
+          }
       } else {
         for (int bb = c0; bb < c1; ++bb) reduce_body(static_cast<std::size_t>(bb));
       }
@@ -1035,13 +1039,10 @@ inline void Simulation::reduce_body(std::size_t b) {
   b_.torque[b] = tq;
 }
 
-// The body forces of the external providers (serial: their code is not ours).
-// Their arrays were cleared by contact_forces()' body loop; the sums into the bodies (in
-// provider order, as before) and the closing half kick (kick_h > 0) run in one parallel loop.
-void Simulation::provider_forces(double kick_h) {
-  const std::size_t nb = b_.x.size();
+// The body forces of the external providers (serial: their code is not ours), into their
+// arrays (cleared by contact_forces()' body phase, or with providers_early by step()'s drift).
+void Simulation::call_providers() {
   const std::size_t np = forces_.size();
-  if (np == 0) return;
   held_.resize(np);
   for (std::size_t k = 0; k < np; ++k) {
     forces_[k]->set_running_threads(team());
@@ -1054,20 +1055,55 @@ void Simulation::provider_forces(double kick_h) {
     if (held_[k].terms < 0 || held_[k].terms > BodyForce::Held::kMaxTerms)
       throw std::logic_error(fmt::format("force provider {}: {} held terms", forces_[k]->name(), held_[k].terms));
   }
+}
+
+// Bodies [b0, b1)'s provider forces added to their sums, per body in provider order: each
+// provider's array value plus its held terms (stored back in its array, which outputs read).
+// (Providers in the outer loop: each body still gets the same additions in the same order.)
+void Simulation::add_provider_forces(std::size_t b0, std::size_t b1) {
   double* fx = b_.fx.data(); double* fy = b_.fy.data(); double* tq = b_.torque.data();
-  double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
-  const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
-  const bool kick = kick_h > 0.0;
-  const BodyForce::Held* held = held_.data();
-#pragma omp parallel for schedule(static) num_threads(team())
-  for (std::size_t b = 0; b < nb; ++b) {
-    for (std::size_t k = 0; k < np; ++k) {
-      double px = prov_fx_[k][b], py = prov_fy_[k][b];
-      for (int q = 0; q < held[k].terms; ++q) { px += held[k].fx[q][b]; py += held[k].fy[q][b]; }
-      if (held[k].terms > 0) { prov_fx_[k][b] = px; prov_fy_[k][b] = py; }
-      fx[b] += px; fy[b] += py; tq[b] += prov_tq_[k][b];
+  for (std::size_t k = 0; k < forces_.size(); ++k) {
+    double* px = prov_fx_[k].data(); double* py = prov_fy_[k].data(); const double* pt = prov_tq_[k].data();
+    const BodyForce::Held& h = held_[k];
+    if (h.terms == 0) {
+      for (std::size_t b = b0; b < b1; ++b) { fx[b] += px[b]; fy[b] += py[b]; tq[b] += pt[b]; }
+    } else if (h.terms == 1) {
+      const double* h0x = h.fx[0]; const double* h0y = h.fy[0];
+      for (std::size_t b = b0; b < b1; ++b) {
+        const double sx = px[b] + h0x[b], sy = py[b] + h0y[b];
+        px[b] = sx; py[b] = sy;
+        fx[b] += sx; fy[b] += sy; tq[b] += pt[b];
+      }
+    } else {
+      const double* h0x = h.fx[0]; const double* h0y = h.fy[0];
+      const double* h1x = h.fx[1]; const double* h1y = h.fy[1];
+      for (std::size_t b = b0; b < b1; ++b) {
+        const double sx = px[b] + h0x[b] + h1x[b], sy = py[b] + h0y[b] + h1y[b];
+        px[b] = sx; py[b] = sy;
+        fx[b] += sx; fy[b] += sy; tq[b] += pt[b];
+      }
     }
-    if (kick) { vx[b] += kick_h * fx[b] * im[b]; vy[b] += kick_h * fy[b] * im[b]; om[b] += kick_h * tq[b] * iI[b]; }
+  }
+}
+
+// The providers' forces after contact_forces(): the sums into the bodies (in provider order)
+// and the closing half kick (kick_h > 0), per thread on its share of the bodies.
+void Simulation::provider_forces(double kick_h) {
+  const std::size_t nb = b_.x.size();
+  if (forces_.empty()) return;
+  call_providers();
+  double* vx = b_.vx.data(); double* vy = b_.vy.data(); double* om = b_.omega.data();
+  const double* fx = b_.fx.data(); const double* fy = b_.fy.data(); const double* tq = b_.torque.data();
+  const double* im = inv_mass_.data(); const double* iI = inv_inertia_.data();
+#pragma omp parallel num_threads(team())
+  {
+    const auto t = static_cast<std::size_t>(omp_get_thread_num()), team_size = static_cast<std::size_t>(omp_get_num_threads());
+    const std::size_t b0 = nb * t / team_size, b1 = nb * (t + 1) / team_size;
+    add_provider_forces(b0, b1);
+    if (kick_h > 0.0)
+      for (std::size_t b = b0; b < b1; ++b) {
+        vx[b] += kick_h * fx[b] * im[b]; vy[b] += kick_h * fy[b] * im[b]; om[b] += kick_h * tq[b] * iI[b];
+      }
   }
 }
 
@@ -1179,6 +1215,12 @@ void Simulation::step() {
   pdisc_.resize(d_.x.size());
   pvel_.resize(d_.x.size());
   if (!simple_valid_ || simple_prefix_.size() != nb + 1) update_simple();
+  // Force providers that read no contact state run before the contact forces, whose pass over
+  // the bodies adds their forces and kicks (BodyForce::reads_contacts): their arrays are
+  // cleared here, per thread on its share of the bodies.
+  const bool providers_early =
+      !forces_.empty() && std::none_of(forces_.begin(), forces_.end(), [](const auto& f) { return f->reads_contacts(); });
+  const std::size_t n_clear = providers_early ? forces_.size() : 0;
 #pragma omp parallel num_threads(team())
   {
   const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
@@ -1191,6 +1233,11 @@ void Simulation::step() {
   for (std::size_t c0 = b0; c0 < b1; c0 += kBlock) {
     const std::size_t c1 = std::min(b1, c0 + kBlock);
     detail::drift_bodies(drift, c0, c1, arrays);
+    for (std::size_t k = 0; k < n_clear; ++k) {
+      std::fill(prov_fx_[k].begin() + c0, prov_fx_[k].begin() + c1, 0.0);
+      std::fill(prov_fy_[k].begin() + c0, prov_fy_[k].begin() + c1, 0.0);
+      std::fill(prov_tq_[k].begin() + c0, prov_tq_[k].begin() + c1, 0.0);
+    }
     // The block's discs (contiguous: bodies own consecutive discs).
     const std::size_t k0 = static_cast<std::size_t>(b_.first_disc[c0]);
     const std::size_t k1 = static_cast<std::size_t>(b_.first_disc[c1 - 1] + b_.n_discs[c1 - 1]);
@@ -1276,12 +1323,19 @@ void Simulation::step() {
   time_ += dt;
   ++step_;
   if (ensure_neighbor_list(check_moves ? moved : -1)) list_room_ = 1;  // (built now: nothing moved yet)
-  // The closing half kick runs where the body forces are complete: without force providers in
-  // contact_forces()' region, with them in provider_forces()' loop that adds their forces (the
-  // same operations either way).
-  const bool kick_in_region = !newmark && forces_.empty();
-  contact_forces(kick_in_region ? 0.5 * dt : 0.0, true);
-  provider_forces(!newmark && !kick_in_region ? 0.5 * dt : 0.0);
+  // The closing half kick runs where the body forces are complete: without force providers, or
+  // with providers that read no contact state (called first), in contact_forces()' region; else
+  // in provider_forces()' loop that adds their forces (the same operations each way).
+  const double kick_h = newmark ? 0.0 : 0.5 * dt;
+  if (forces_.empty()) {
+    contact_forces(kick_h, true);
+  } else if (providers_early) {
+    call_providers();
+    contact_forces(kick_h, true, true);
+  } else {
+    contact_forces(0.0, true);
+    provider_forces(kick_h);
+  }
   forces_valid_ = true;
   tuner_.step_done(omp_get_wtime() - t_start);
 }

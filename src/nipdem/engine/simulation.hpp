@@ -92,6 +92,12 @@ class BodyForce {
   // instead of comparing the ids at every call.
   std::uint64_t body_set_version() const { return body_set_version_; }
   void set_body_set_version(std::uint64_t v) { body_set_version_ = v; }
+  // Whether add() reads what the engine's contact forces of the same step write (the contact
+  // network, the discs' forces, the contact count). A provider whose add() reads only bodies,
+  // discs' positions and time may say false: the engine then calls it before the contact forces
+  // of a step and adds its forces (and the closing half kick) in their pass over the bodies,
+  // one parallel region per step fewer, with the same operations in the same order.
+  virtual bool reads_contacts() const { return true; }
 
  private:
   int running_threads_ = 0;
@@ -211,6 +217,7 @@ class Simulation {
   // Per-provider force on each body from the last evaluation (for output) [N].
   const std::vector<double>& provider_fx(std::size_t k) const { return prov_fx_[k]; }
   const std::vector<double>& provider_fy(std::size_t k) const { return prov_fy_[k]; }
+  const std::vector<double>& provider_torque(std::size_t k) const { return prov_tq_[k]; }  // [N m]
   // Number of disc-disc and disc-wall contacts (overlap > 0) in the last evaluation.
   std::int64_t contacts() const { return n_contacts_; }
   // The thread-count choice (EngineParams::run_threads): threads in use, probes and switches so far.
@@ -231,13 +238,17 @@ class Simulation {
   // kick_h > 0: also the closing half kick of velocity Verlet, body by body as its force is summed
   // (step() without force providers: one parallel region fewer per step); packed: step() has
   // already made the pair kernel's copy of the discs (pdisc_, pvel_) from the present state
-  void contact_forces(double kick_h = 0.0, bool packed = false);
+  // providers: call_providers() has run, and the body phase adds their forces before the kick
+  // (step() when no provider reads_contacts(): the provider loop's region goes)
+  void contact_forces(double kick_h = 0.0, bool packed = false, bool providers = false);
   void prepare_walls();
   void wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
   std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits);  // (updates wall_hint_)
   bool walls_within_margin() const;
   void reduce_body(std::size_t b);
-  void provider_forces(double kick_h);  // (contact_forces() clears their arrays first)
+  void provider_forces(double kick_h);  // call_providers(), then their sums (and kick) per body
+  void call_providers();  // each provider's add() into its cleared arrays, held_ from it
+  void add_provider_forces(std::size_t b0, std::size_t b1);  // into the bodies' sums, held terms stored back
   void update_thread_split();
   void build_wall_candidates();
   struct WallShape {

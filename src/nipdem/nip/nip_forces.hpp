@@ -55,6 +55,7 @@ class MagnetForce final : public engine::BodyForce {
   // The field force and the dipole-dipole force of the last evaluation, for the engine to add
   // (engine::BodyForce::Held; add() then leaves them out).
   Held held() const override;
+  bool reads_contacts() const override { return false; }  // (positions, sizes and ids only)
   // Dipole-dipole part of the last evaluation, per body [N] (for tests and output).
   const std::vector<double>& dipole_fx() const { return dfx_; }
   const std::vector<double>& dipole_fy() const { return dfy_; }
