@@ -1258,7 +1258,33 @@ void Simulation::step() {
         pv[k] = {vx[b] - w * 0.0, vy[b] + w * 0.0, w, 0.0};
       }
     } else {
-      for (std::size_t b = c0; b < c1; ++b) place_body(b);
+      // place_body and pack_disc in one pass: the same values (pack_disc reads back what
+      // place_body wrote; a body's discs are its own), each disc's offset used while in a register.
+      const double* r = d_.r.data(); const double* ox = d_.ox.data(); const double* oy = d_.oy.data();
+      const double* mass = b_.mass.data(); const double* cth = b_.cth.data(); const double* sth = b_.sth.data();
+      const int* first_disc = b_.first_disc.data(); const int* n_discs = b_.n_discs.data();
+      double* dx = d_.x.data(); double* dy = d_.y.data(); double* dwx = d_.wx.data(); double* dwy = d_.wy.data();
+      PackedDisc* pd = pdisc_.data(); PackedVel* pv = pvel_.data();
+      for (std::size_t b = c0; b < c1; ++b) {
+        const int first = first_disc[b], nd = n_discs[b];
+        const double X = x[b], Y = y[b], w = om[b], m = mass[b], u = vx[b], v = vy[b];
+        if (nd == 1 && ox[first] == 0.0 && oy[first] == 0.0) {
+          dx[first] = X; dy[first] = Y; dwx[first] = 0.0; dwy[first] = 0.0;
+          pd[first] = {X, Y, r[first], m};
+          pv[first] = {u - w * 0.0, v + w * 0.0, w, 0.0};
+          continue;
+        }
+        const double c = cth[b], sn = sth[b];
+        for (int k = first; k < first + nd; ++k) {
+          const double wx = c * ox[k] - sn * oy[k];
+          const double wy = sn * ox[k] + c * oy[k];
+          const double px = X + wx, py = Y + wy;
+          dwx[k] = wx; dwy[k] = wy;
+          dx[k] = px; dy[k] = py;
+          pd[k] = {px, py, r[k], m};
+          pv[k] = {u - w * wy, v + w * wx, w, 0.0};
+        }
+      }
     }
     if (check_list && !list_per_disc)
       for (std::size_t k = k0; k < k1; ++k) geometry::NeighborList::top2(nlist_.displacement2(k, d_.x[k], d_.y[k]), d1, d2);
@@ -1278,8 +1304,6 @@ void Simulation::step() {
                                                                  sub_y0_.data(), k0, k1, periodic, L);
       s1 = m > s1 || m != m ? m : s1;  // (NaN wins)
     }
-    if (!simple)
-      for (std::size_t k = k0; k < k1; ++k) pack_disc(static_cast<int>(k));
   }
   thread_disp_[4 * t] = d1;
   thread_disp_[4 * t + 1] = d2;
