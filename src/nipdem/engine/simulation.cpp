@@ -839,7 +839,7 @@ void Simulation::contact_forces(double kick_h, bool packed, bool providers) {
         std::copy(d_.y.begin() + k0, d_.y.begin() + k1, sub_y0_.begin() + k0);
       }
       if (simple_blocks && simple_prefix_[c1] - simple_prefix_[c0] == c1 - c0) {
-        // One disc per body at its centre (step()): reduce_body's sums with its offset (0, 0),
+        // One disc per body at its centre (step()): reduce_bodies' sums with its offset (0, 0),
         // in one loop without the disc ranges.
         const Vec2 g = params_.gravity;
         const double* m = b_.mass.data();
@@ -859,14 +859,15 @@ void Simulation::contact_forces(double kick_h, bool packed, bool providers) {
           }
       } else if (kick_h > 0.0 || providers) {
         // The same operations as provider_forces()' loop, so the same bits.
-        for (int bb = c0; bb < c1; ++bb) reduce_body(static_cast<std::size_t>(bb));
+        reduce_bodies(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1));
         if (providers) add_provider_forces(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1));
+        const double* bfx = b_.fx.data(); const double* bfy = b_.fy.data(); const double* btq = b_.torque.data();
         if (kick_h > 0.0)
           for (int bb = c0; bb < c1; ++bb) {
-            vx[bb] += kick_h * b_.fx[bb] * im[bb]; vy[bb] += kick_h * b_.fy[bb] * im[bb]; om[bb] += kick_h * b_.torque[bb] * iI[bb];
+            vx[bb] += kick_h * bfx[bb] * im[bb]; vy[bb] += kick_h * bfy[bb] * im[bb]; om[bb] += kick_h * btq[bb] * iI[bb];
           }
       } else {
-        for (int bb = c0; bb < c1; ++bb) reduce_body(static_cast<std::size_t>(bb));
+        reduce_bodies(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1));
       }
     }
     thread_nc_[t] += wall_nc;
@@ -1025,18 +1026,24 @@ void Simulation::wall_disc(std::size_t i, std::uint32_t mask, std::vector<geomet
   if (touched) { d_.fx[i] += fx; d_.fy[i] += fy; d_.tq[i] += tq; }
 }
 
-// Total force and torque about the centre of mass of body b from its discs, plus gravity.
-inline void Simulation::reduce_body(std::size_t b) {
+// Total force and torque about the centre of mass of bodies [b0, b1) from their discs, plus gravity.
+inline void Simulation::reduce_bodies(std::size_t b0, std::size_t b1) {
   const Vec2 g = params_.gravity;
-  const int first = b_.first_disc[b], nd = b_.n_discs[b];
-  double fx = 0, fy = 0, tq = 0;
-  for (int k = first; k < first + nd; ++k) {
-    fx += d_.fx[k]; fy += d_.fy[k];
-    tq += d_.tq[k] + d_.wx[k] * d_.fy[k] - d_.wy[k] * d_.fx[k];
+  const int* first_disc = b_.first_disc.data(); const int* n_discs = b_.n_discs.data();
+  const double* dfx = d_.fx.data(); const double* dfy = d_.fy.data(); const double* dtq = d_.tq.data();
+  const double* wx = d_.wx.data(); const double* wy = d_.wy.data(); const double* mass = b_.mass.data();
+  double* bfx = b_.fx.data(); double* bfy = b_.fy.data(); double* btq = b_.torque.data();
+  for (std::size_t b = b0; b < b1; ++b) {
+    const int first = first_disc[b], nd = n_discs[b];
+    double fx = 0, fy = 0, tq = 0;
+    for (int k = first; k < first + nd; ++k) {
+      fx += dfx[k]; fy += dfy[k];
+      tq += dtq[k] + wx[k] * dfy[k] - wy[k] * dfx[k];
+    }
+    bfx[b] = fx + mass[b] * g.x;
+    bfy[b] = fy + mass[b] * g.y;
+    btq[b] = tq;
   }
-  b_.fx[b] = fx + b_.mass[b] * g.x;
-  b_.fy[b] = fy + b_.mass[b] * g.y;
-  b_.torque[b] = tq;
 }
 
 // The body forces of the external providers (serial: their code is not ours), into their

@@ -245,7 +245,7 @@ class Simulation {
   void wall_disc(std::size_t i, std::uint32_t mask, std::vector<geometry::WallHit>& hits, std::int64_t& nc);
   std::uint32_t walls_near(std::size_t i, double margin, std::vector<geometry::WallHit>& hits);  // (updates wall_hint_)
   bool walls_within_margin() const;
-  void reduce_body(std::size_t b);
+  void reduce_bodies(std::size_t b0, std::size_t b1);  // disc forces into body sums (+ gravity)
   void provider_forces(double kick_h);  // call_providers(), then their sums (and kick) per body
   void call_providers();  // each provider's add() into its cleared arrays, held_ from it
   void add_provider_forces(std::size_t b0, std::size_t b1);  // into the bodies' sums, held terms stored back
