@@ -157,6 +157,39 @@ TEST(FaultAlloc, WarmForceEvaluationAllocatesNothingInsideItsRegions) {
   }
 }
 
+// Which thread queries a disc's walls is decided at run time (BlockSteal): a thread that never
+// ran a wall block before must not grow its hit list inside the region (CI saw the test above fail
+// once when, on a loaded machine, the second thread took the first thread's wall block). Here the
+// warm-up runs on one thread, so only thread 0's list has grown; then both threads run a row of
+// discs that all touch the wall, so both query walls in the armed step.
+TEST(FaultAlloc, AThreadNewToWallQueriesAllocatesNothingInsideTheRegion) {
+  engine::EngineParams p;
+  p.interactions = {engine::Interaction{}};
+  p.dt = 1e-9;
+  p.threads = 2;
+  p.run_threads = 1;
+  p.gravity = {0, -9.81};
+  engine::Simulation sim(p, {geometry::Wall{}});
+  for (int i = 0; i < 600; ++i) {  // one row on the plane y = 0: every body block has wall contacts
+    engine::BodySpec s;
+    s.offsets = {{0, 0}};
+    s.radii = {4e-6};
+    s.density = 1500;
+    s.position = {i * 8.5e-6 + 5e-6, 3.99e-6};
+    sim.add_body(s);
+  }
+  for (int k = 0; k < 20; ++k) sim.step();
+  ASSERT_EQ(sim.team_tuner().team(), 1);
+  sim.mutable_params().run_threads = 2;
+  const auto n_before = sim.neighbor_list().builds();
+  FailInParallel armed;
+  sim.step();
+  sim.step();
+  EXPECT_EQ(g_failed.load(), 0);
+  EXPECT_EQ(sim.team_tuner().team(), 2);
+  EXPECT_EQ(sim.neighbor_list().builds(), n_before);
+}
+
 // The dipole pair list is built on the running threads, its rows growing inside the region: a
 // failed allocation there is carried out as std::bad_alloc (not std::terminate), and the next
 // pass builds the list and gives the reference sums. The sum itself allocates nothing inside

@@ -952,6 +952,12 @@ void Simulation::prepare_walls() {
     wall_reach_[w] = ad.hamaker_J != 0.0 ? ad.cutoff_m : 0.0;
   }
   if (static_cast<int>(thread_hits_.size()) < params_.threads) thread_hits_.resize(params_.threads);
+  // Which thread queries a disc's walls is decided at run time (BlockSteal), so every thread's hit
+  // list gets the largest capacity any has needed: a thread new to a wall block does not grow its
+  // list inside the region (an allocation there is a bad_alloc to carry out, and a needless call).
+  std::size_t cap = 0;
+  for (const auto& h : thread_hits_) cap = std::max(cap, h.v.capacity());
+  for (auto& h : thread_hits_) h.v.reserve(cap);
 }
 
 // Wall forces on disc i, added to its force arrays; wall history slots updated.
