@@ -208,6 +208,63 @@ TEST(NeighborList, SkinsPerDiscListExactlyThePairsWithinTheirReach) {
   }
 }
 
+// The row search skips, cell by cell, the discs with an index below the row's (a cell holds its
+// discs in index order). In the spatial order the engine keeps bodies in (strips along x, then y)
+// most cells are skipped whole or cut inside; in random order few are. Either way the list is
+// exactly the pairs within reach (brute force), with one skin for all or skins per disc,
+// periodic or not. Random positions: no pair sits on the boundary to rounding.
+TEST(NeighborList, RowsThatSkipLowerIndicesListExactlyThePairsWithinReach) {
+  for (bool sorted : {false, true})
+    for (bool periodic : {false, true})
+      for (bool per_disc : {false, true}) {
+        test::DiscCloud d = test::random_discs(2500, 300e-6, 17, 2);
+        if (sorted) {  // bodies in strips of 24 um along x, then by y (as sort_bodies_spatially)
+          std::vector<int> order(d.x.size() / 2);
+          for (std::size_t b = 0; b < order.size(); ++b) order[b] = static_cast<int>(b);
+          std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+            const double sa = std::floor(d.x[2 * a] / 24e-6), sb = std::floor(d.x[2 * b] / 24e-6);
+            return sa != sb ? sa < sb : d.y[2 * a] < d.y[2 * b];
+          });
+          test::DiscCloud s;
+          for (std::size_t b = 0; b < order.size(); ++b)
+            for (int q = 0; q < 2; ++q) {
+              const std::size_t k = 2 * static_cast<std::size_t>(order[b]) + q;
+              s.x.push_back(d.x[k]); s.y.push_back(d.y[k]); s.r.push_back(d.r[k]);
+              s.body.push_back(static_cast<int>(b));
+            }
+          d = s;
+        }
+        geometry::NeighborListParams p;
+        p.skin = 1e-6;
+        p.extra_range = 0.3e-6;
+        p.periodic_x = periodic;
+        p.x_lo = 0;
+        p.x_hi = 300e-6;
+        p.threads = 2;
+        std::vector<double> h;
+        if (per_disc) {
+          Rng rng(6);
+          h.assign(d.x.size(), 0.5e-6);
+          for (auto& v : h) v = rng.uniform(0.2e-6, 1.5e-6);
+        }
+        geometry::NeighborList nl;
+        nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h);
+        std::set<std::pair<int, int>> want;
+        for (std::size_t i = 0; i < d.x.size(); ++i)
+          for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+            if (d.body[i] == d.body[j]) continue;
+            double dx = d.x[i] - d.x[j];
+            if (periodic) dx -= 300e-6 * std::nearbyint(dx / 300e-6);
+            const double dy = d.y[i] - d.y[j];
+            const double rc = d.r[i] + d.r[j] + p.extra_range + (per_disc ? h[i] + h[j] : p.skin);
+            if (dx * dx + dy * dy < rc * rc) want.insert({static_cast<int>(i), static_cast<int>(j)});
+          }
+        ASSERT_GT(want.size(), 2000u);
+        EXPECT_EQ(listed(nl), want) << (sorted ? "sorted " : "random ") << (periodic ? "periodic " : "open ")
+                                    << (per_disc ? "skins per disc" : "one skin");
+      }
+}
+
 // The criterion with skins per disc: rebuilt when a disc has moved farther than its own skin
 // (track(), needs_rebuild()). Random walks where four discs move 20 times faster than the rest
 // and have skins 4 times wider: at every step every pair within the interaction range is

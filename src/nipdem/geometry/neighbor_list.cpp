@@ -223,6 +223,25 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
           m += static_cast<int>((d.index > ii) & (d.body != bi) & (dx * dx + dy * dy < rc * rc));
         }
       };
+      // Cells c0..c1 (consecutive): a row keeps only larger indices, and a cell holds its discs
+      // in index order, so the leading discs with an index <= i are skipped without a test:
+      // whole cells by their last index, then the first cell that reaches past i from its first
+      // larger index. In the spatial order the engine keeps bodies in, about half the stencil's
+      // discs are skipped so; the row is the same set either way (the skipped ones fail the test).
+      auto scan_cells = [&](std::size_t c0, std::size_t c1) __attribute__((always_inline)) {
+        const int k1 = cell_start_[c1 + 1];
+        int k = k1;
+        for (std::size_t c = c0; c <= c1; ++c) {
+          const int e = cell_start_[c + 1];
+          if (e > cell_start_[c] && binned_[static_cast<std::size_t>(e - 1)].index > ii) {
+            const Binned* first = std::partition_point(binned_.data() + cell_start_[c], binned_.data() + e,
+                                                       [ii](const Binned& d) { return d.index <= ii; });
+            k = static_cast<int>(first - binned_.data());
+            break;
+          }
+        }
+        scan(k, k1);
+      };
       for (int dyc = -1; dyc <= 1; ++dyc) {
         const int yy = cy + dyc;
         if (yy < 0 || yy >= ny) continue;
@@ -231,12 +250,12 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
           // the (up to) three cells of this row of the stencil lie together in cell order
           const std::size_t c0 = c_row + static_cast<std::size_t>(std::max(cx - 1, 0));
           const std::size_t c1 = c_row + static_cast<std::size_t>(std::min(cx + 1, nx - 1));
-          scan(cell_start_[c0], cell_start_[c1 + 1]);
+          scan_cells(c0, c1);
         } else {
           for (int dxc = -1; dxc <= 1; ++dxc) {
             const int xx = ((cx + dxc) % nx + nx) % nx;  // tiny boxes (nx < 3) give duplicates, removed below
             const std::size_t c = c_row + static_cast<std::size_t>(xx);
-            scan(cell_start_[c], cell_start_[c + 1]);
+            scan_cells(c, c);
           }
         }
       }
