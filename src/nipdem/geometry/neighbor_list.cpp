@@ -121,7 +121,9 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
   cell_fill_.assign(cell_start_.begin(), cell_start_.end() - 1);
   binned_.resize(n);
   if (per_disc) binned_h_.resize(n);
+  cell_last_.assign(ncell, -1);  // each cell's largest disc index (its last), -1 if empty
   for (std::size_t i = 0; i < n; ++i) {
+    cell_last_[static_cast<std::size_t>(cell_of_[i])] = static_cast<int>(i);
     const int k = cell_fill_[static_cast<std::size_t>(cell_of_[i])]++;
     binned_[static_cast<std::size_t>(k)] = {x[i], y[i], r[i], static_cast<int>(i), body[i]};
     if (per_disc) binned_h_[static_cast<std::size_t>(k)] = half_skin[i];
@@ -224,23 +226,18 @@ void NeighborList::rebuild(std::span<const double> x, std::span<const double> y,
         }
       };
       // Cells c0..c1 (consecutive): a row keeps only larger indices, and a cell holds its discs
-      // in index order, so the leading discs with an index <= i are skipped without a test:
-      // whole cells by their last index, then the first cell that reaches past i from its first
-      // larger index. In the spatial order the engine keeps bodies in, about half the stencil's
-      // discs are skipped so; the row is the same set either way (the skipped ones fail the test).
+      // in index order, so leading cells whose last index is <= i are skipped without a test of
+      // their discs. In the spatial order the engine keeps bodies in, that is about a third of
+      // the stencil's discs; the row is the same set either way (the skipped ones fail the
+      // test). Without a branch: whether a cell is skipped is what a predictor cannot learn.
       auto scan_cells = [&](std::size_t c0, std::size_t c1) __attribute__((always_inline)) {
-        const int k1 = cell_start_[c1 + 1];
-        int k = k1;
+        int k = cell_start_[c0];
+        bool skip = true;
         for (std::size_t c = c0; c <= c1; ++c) {
-          const int e = cell_start_[c + 1];
-          if (e > cell_start_[c] && binned_[static_cast<std::size_t>(e - 1)].index > ii) {
-            const Binned* first = std::partition_point(binned_.data() + cell_start_[c], binned_.data() + e,
-                                                       [ii](const Binned& d) { return d.index <= ii; });
-            k = static_cast<int>(first - binned_.data());
-            break;
-          }
+          skip = skip & (cell_last_[c] <= ii);
+          k = skip ? cell_start_[c + 1] : k;
         }
-        scan(k, k1);
+        scan(k, cell_start_[c1 + 1]);
       };
       for (int dyc = -1; dyc <= 1; ++dyc) {
         const int yy = cy + dyc;

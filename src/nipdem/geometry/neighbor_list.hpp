@@ -125,7 +125,7 @@ class NeighborList {
   int builds_ = 0;
   // scratch reused across builds (no per-step allocation)
   struct Binned { double x, y, r; int index, body; };  // a disc in cell order
-  std::vector<int> cell_start_, cell_fill_, cell_of_;
+  std::vector<int> cell_start_, cell_fill_, cell_of_, cell_last_;
   std::vector<Binned> binned_;
   std::vector<double> binned_h_;  // skins per disc, in cell order
   // pairs (i < j) found by the wide search of discs whose skins reach beyond their 3 x 3 cells,
