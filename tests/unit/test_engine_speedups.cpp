@@ -89,6 +89,23 @@ std::set<std::pair<int, int>> listed(const geometry::NeighborList& nl) {
     for (int k = nl.row_start_[i]; k < nl.row_start_[i + 1]; ++k) s.insert({static_cast<int>(i), nl.nbr_[k]});
   return s;
 }
+// Brute force over all pairs: the pairs (i < j) of discs of different bodies within
+// r_i + r_j + extra + h_i + h_j of each other (skins per disc h), or r_i + r_j + extra + skin if h
+// is empty; with the minimum image along x if the box is periodic with width L > 0.
+std::set<std::pair<int, int>> pairs_within(const test::DiscCloud& d, double extra, double skin,
+                                           const std::vector<double>& h, double L) {
+  std::set<std::pair<int, int>> want;
+  for (std::size_t i = 0; i < d.x.size(); ++i)
+    for (std::size_t j = i + 1; j < d.x.size(); ++j) {
+      if (d.body[i] == d.body[j]) continue;
+      double dx = d.x[i] - d.x[j];
+      if (L > 0.0) dx -= L * std::nearbyint(dx / L);
+      const double dy = d.y[i] - d.y[j];
+      const double rc = h.empty() ? d.r[i] + d.r[j] + extra + skin : d.r[i] + d.r[j] + extra + h[i] + h[j];
+      if (dx * dx + dy * dy < rc * rc) want.insert({static_cast<int>(i), static_cast<int>(j)});
+    }
+  return want;
+}
 // The pairs of discs of different bodies within r_i + r_j + extra of each other that `have`
 // lacks (brute force over all pairs): how many, and the first as "i,j".
 struct Unlisted { int count = 0; std::string first; };
@@ -190,16 +207,7 @@ TEST(NeighborList, SkinsPerDiscListExactlyThePairsWithinTheirReach) {
     EXPECT_EQ(lists[1].row_start_, lists[0].row_start_);
     EXPECT_EQ(lists[1].nbr_, lists[0].nbr_);
     EXPECT_GT(lists[0].wide_discs(), 100u);  // the wide search ran
-    std::set<std::pair<int, int>> want;
-    for (std::size_t i = 0; i < d.x.size(); ++i)
-      for (std::size_t j = i + 1; j < d.x.size(); ++j) {
-        if (d.body[i] == d.body[j]) continue;
-        double dx = d.x[i] - d.x[j];
-        if (periodic) dx -= 400e-6 * std::nearbyint(dx / 400e-6);
-        const double dy = d.y[i] - d.y[j];
-        const double rc = d.r[i] + d.r[j] + p.extra_range + h[i] + h[j];
-        if (dx * dx + dy * dy < rc * rc) want.insert({static_cast<int>(i), static_cast<int>(j)});
-      }
+    const std::set<std::pair<int, int>> want = pairs_within(d, p.extra_range, 0.0, h, periodic ? 400e-6 : 0.0);
     EXPECT_EQ(listed(lists[0]), want) << (periodic ? "periodic" : "open");
     // rows sorted, no repeats (the wide pairs merged into them)
     for (std::size_t i = 0; i < lists[0].size(); ++i)
@@ -249,16 +257,7 @@ TEST(NeighborList, RowsThatSkipLowerIndicesListExactlyThePairsWithinReach) {
         }
         geometry::NeighborList nl;
         nl.rebuild(d.x, d.y, d.r, d.body, {}, p, h);
-        std::set<std::pair<int, int>> want;
-        for (std::size_t i = 0; i < d.x.size(); ++i)
-          for (std::size_t j = i + 1; j < d.x.size(); ++j) {
-            if (d.body[i] == d.body[j]) continue;
-            double dx = d.x[i] - d.x[j];
-            if (periodic) dx -= 300e-6 * std::nearbyint(dx / 300e-6);
-            const double dy = d.y[i] - d.y[j];
-            const double rc = d.r[i] + d.r[j] + p.extra_range + (per_disc ? h[i] + h[j] : p.skin);
-            if (dx * dx + dy * dy < rc * rc) want.insert({static_cast<int>(i), static_cast<int>(j)});
-          }
+        const std::set<std::pair<int, int>> want = pairs_within(d, p.extra_range, p.skin, h, periodic ? 300e-6 : 0.0);
         ASSERT_GT(want.size(), 2000u);
         EXPECT_EQ(listed(nl), want) << (sorted ? "sorted " : "random ") << (periodic ? "periodic " : "open ")
                                     << (per_disc ? "skins per disc" : "one skin");
