@@ -600,6 +600,56 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
     return;
   }
   constexpr int kB = 1 << kTouchShift;
+  // Discs [s, e) of touch block tb (from base) reached by one earlier part only, through its slots
+  // [q0, q1): their sums are S + own, and own + S has the same bits (addition commutes; 0 + own
+  // is own but for -0, and S + -0 = S: S is never -0). So after the plain loop each reached disc's
+  // S (from +0, in entry order) is added.
+  auto add_slots = [&](int q0, int q1, int s, int e, int base) __attribute__((always_inline)) {
+    double sx[kB], sy[kB], st[kB];
+    bool open[kB];  // reached, S not yet added
+    for (int q = q0; q < q1; ++q) {
+      const int j = cross_disc_[q];
+      if (j < s || j >= e) continue;  // (a block of 2^kTouchShift discs may span two blocks of bodies)
+      sx[j - base] = sy[j - base] = st[j - base] = 0.0;
+      open[j - base] = true;
+    }
+    for (int q = q0; q < q1; ++q) {
+      const int j = cross_disc_[q];
+      if (j < s || j >= e) continue;
+      CrossForce& v = cross_val_[q];
+      sx[j - base] -= v.fx; sy[j - base] -= v.fy; st[j - base] += v.tq;
+      v = CrossForce{0.0, 0.0, 0.0};
+    }
+    for (int q = q0; q < q1; ++q) {  // each reached disc once
+      const int j = cross_disc_[q];
+      if (j < s || j >= e || !open[j - base]) continue;
+      dfx[j] += sx[j - base]; dfy[j] += sy[j - base]; dtq[j] += st[j - base];
+      open[j - base] = false;
+    }
+  };
+  // Where no touch block is reached by two earlier parts (always with two parts), one plain loop
+  // over all the discs and then the slots: the plain loop split at every touch block of a reached
+  // block of bodies cost one part running two 0.2 % of its instructions (packing, cachegrind).
+  bool single = true;
+  for (int tb = b0; tb < b1 && single && nt > 2; ++tb) {
+    int np = 0;
+    for (int u = 0; u + 1 < nt; ++u) {
+      const int* c = cross_block_.data() + static_cast<std::size_t>(u) * tb2;
+      np += c[tb] < c[tb + 1] ? 1 : 0;
+    }
+    single = np < 2;
+  }
+  if (single) {
+    plain(k0, k1);
+    for (int u = 0; u + 1 < nt; ++u) {
+      const int* c = cross_block_.data() + static_cast<std::size_t>(u) * tb2;
+      for (int tb = b0; tb < b1; ++tb)
+        if (c[tb] < c[tb + 1])
+          add_slots(c[tb], c[tb + 1], std::max(k0, tb << kTouchShift), std::min(k1, (tb + 1) << kTouchShift),
+                    tb << kTouchShift);
+    }
+    return;
+  }
   for (int tb = b0; tb < b1; ++tb) {
     const int s = std::max(k0, tb << kTouchShift), e = std::min(k1, (tb + 1) << kTouchShift);
     const int base = tb << kTouchShift;
@@ -613,33 +663,9 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
       continue;
     }
     if (np == 1) {
-      // One earlier part reaches these discs: their sums are S + own, and own + S has the same
-      // bits (addition commutes; 0 + own is own but for -0, and S + -0 = S: S is never -0). So
-      // the plain loop, then each reached disc's S added, found from the part's few slots.
       plain(s, e);
       const int* c = cross_block_.data() + static_cast<std::size_t>(only) * tb2;
-      const int q0 = c[tb], q1 = c[tb + 1];
-      double sx[kB], sy[kB], st[kB];
-      bool open[kB];  // reached, S not yet added
-      for (int q = q0; q < q1; ++q) {
-        const int j = cross_disc_[q];
-        if (j < s || j >= e) continue;
-        sx[j - base] = sy[j - base] = st[j - base] = 0.0;
-        open[j - base] = true;
-      }
-      for (int q = q0; q < q1; ++q) {
-        const int j = cross_disc_[q];
-        if (j < s || j >= e) continue;
-        CrossForce& v = cross_val_[q];
-        sx[j - base] -= v.fx; sy[j - base] -= v.fy; st[j - base] += v.tq;
-        v = CrossForce{0.0, 0.0, 0.0};
-      }
-      for (int q = q0; q < q1; ++q) {  // each reached disc once
-        const int j = cross_disc_[q];
-        if (j < s || j >= e || !open[j - base]) continue;
-        dfx[j] += sx[j - base]; dfy[j] += sy[j - base]; dtq[j] += st[j - base];
-        open[j - base] = false;
-      }
+      add_slots(c[tb], c[tb + 1], s, e, base);
       continue;
     }
     bool has = false;
