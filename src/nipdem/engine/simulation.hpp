@@ -268,9 +268,10 @@ class Simulation {
   struct SubEntry { int e, i, j; };
   // kCross: rows before the last part's, whose partners from i1 on go to their cross slots.
   // kList: 0 = test every entry of rows [i0, i1); 1 = the same, and take the sublist of those
-  // rows into sub/sub_n; 2 = test only the sublist sub[0, sub_n).
+  // rows into sub/sub_n (and with kCross the places of its cross entries into xs/xs_n, room for
+  // the part's cross entries + 1); 2 = test only the sublist sub[0, sub_n).
   template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
-  void pair_rows(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sub_n);
+  void pair_rows(int i0, int i1, PackedForce* f, std::int64_t& nc, SubEntry* sub, int& sub_n, int* xs, int& xs_n);
   // The pair sums of discs [k0, k1) (a block of bodies) into d_.fx/fy/tq, the buffers cleared.
   void reduce_pair_sums(int k0, int k1);
   bool sublist_moved() const;  // two largest displacements since the sublist exceed its margin
@@ -346,6 +347,8 @@ class Simulation {
   // split, its entries, and what it was taken for (list build, threads, reach, margin, positions).
   std::vector<std::vector<SubEntry>> sub_;
   std::vector<int> sub_n_;
+  std::vector<std::vector<int>> subx_;  // per part: the places of the sublist's cross entries
+  std::vector<int> subx_n_;
   std::vector<double> sub_x0_, sub_y0_;
   std::vector<std::uint32_t> wall_near_;  // per disc: candidate walls within reach + margin when taken
   std::vector<double> sub_wall_angle_;    // wall angles when taken
