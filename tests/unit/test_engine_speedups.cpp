@@ -562,7 +562,9 @@ TEST(PartBuffers, EveryPartCountSumsTheSameForces) {
       sim.mutable_params().run_threads = parts;
       for (int k = 0; k < 40; ++k) sim.step();
       EXPECT_GT(sim.contacts(), 10);
-      if (parts > 1) EXPECT_GT(sim.pair_cross_entries(), 0) << parts << " parts";
+      if (parts > 1) {
+        EXPECT_GT(sim.pair_cross_entries(), 0) << parts << " parts";
+      }
       std::vector<double> w = sim.bodies().vx;
       w.insert(w.end(), sim.bodies().vy.begin(), sim.bodies().vy.end());
       v.push_back(std::move(w));
