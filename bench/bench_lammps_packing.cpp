@@ -274,8 +274,9 @@ int main(int argc, char** argv) {
               "LAMMPS contact/atom) all_contacts=%lld\n",
               ke_t, ke_r, contacts_per_disc(sim), static_cast<long long>(sim.contacts()));
   const auto& tt = sim.team_tuner();
-  std::printf("  thread use: %s, %d threads at the end, %d probes, %d switches\n",
-              tt.adaptive() ? "measured (run_threads=0)" : "fixed", tt.team(), tt.probes(), tt.switches());
+  std::printf("  thread use: %s, %d threads at the end, %d probes (%d started by a slowdown), %d switches\n",
+              tt.adaptive() ? "measured (run_threads=0)" : "fixed", tt.team(), tt.probes(), tt.early_probes(),
+              tt.switches());
   std::printf("RESULT nipdem threads=%d steps=%ld wall_s=%.4f cpu_s=%.4f disc_steps_per_s=%.6g\n", threads, steps, wall, cpu, rate);
   return 0;
 }

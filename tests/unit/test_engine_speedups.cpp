@@ -589,14 +589,16 @@ TEST(TeamTuner, KeepsTheFasterTeamAndProbesAgain) {
   auto run = [&](int steps, double t1, double t2) {  // step time with 1 and with 2 threads
     for (int k = 0; k < steps; ++k) t.step_done(t.team() == 1 ? t1 : t2);
   };
-  run(TeamTuner::kWarmupSteps, 1.0, 0.6);
+  run(TeamTuner::kWarmupSteps, 1.0, 0.9);
   // probe: 2 threads faster (a free core): kept
-  run(TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 0.6);
+  run(TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 0.9);
   EXPECT_EQ(t.team(), 2);
   EXPECT_EQ(t.probes(), 1);
-  // another job takes a core: 2 threads now slower (by less than the 1.5x that ends a probe
-  // early); the next probe, after a doubled hold, switches to 1
+  // another job takes a core: 2 threads now slower than 1 (by less than the 1.5x that ends a
+  // probe early, and than the 1.5x of the probe's time that the watch reacts to); the next
+  // probe, after a doubled hold, switches to 1
   run(2 * TeamTuner::kHoldSteps + TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks, 1.0, 1.3);
+  EXPECT_EQ(t.early_probes(), 0);
   EXPECT_EQ(t.team(), 1);
   EXPECT_EQ(t.switches(), 1);
   EXPECT_EQ(t.probes(), 2);
@@ -618,6 +620,51 @@ TEST(TeamTuner, KeepsTheFasterTeamAndProbesAgain) {
   TeamTuner f(2, 1);
   EXPECT_FALSE(f.adaptive());
   EXPECT_EQ(f.team(), 1);
+}
+
+// While it holds two threads the tuner watches their step time: kSlowBlocks blocks in a row
+// slower than kSlowFactor x the probe's median block start a probe at once (a wrong choice, or a
+// core taken after the probe, ran 0.56x of one thread for a whole benchmark before). Blocks that
+// are slow now and then do not, and one thread is not watched. Step times made up.
+TEST(TeamTuner, TwoThreadsThatSlowDownWhileHeldAreProbedAtOnce) {
+  constexpr int kProbe = TeamTuner::kBlockSteps * TeamTuner::kProbeBlocks;
+  auto start = [&](TeamTuner& t, double t1, double t2) {  // warm-up and the first probe
+    for (int k = 0; k < TeamTuner::kWarmupSteps + kProbe; ++k) t.step_done(t.team() == 1 ? t1 : t2);
+  };
+  TeamTuner t(2);
+  start(t, 1.0, 0.8);  // a free core: 2 threads kept (a full probe: 0.8 is not 1.5x faster)
+  ASSERT_EQ(t.team(), 2);
+  ASSERT_EQ(t.probes(), 1);
+  // a core is taken: 2 threads 2.5x slower than probed; after the watch's first kWatchAfterSteps
+  // and kSlowBlocks slow blocks a probe starts, and it chooses 1 thread, thousands of steps
+  // before the (doubled) hold would have ended
+  const int react = TeamTuner::kWatchAfterSteps + TeamTuner::kSlowBlocks * TeamTuner::kBlockSteps;
+  for (int k = 0; k < react + kProbe; ++k) t.step_done(t.team() == 1 ? 1.0 : 2.0);
+  EXPECT_EQ(t.early_probes(), 1);
+  EXPECT_EQ(t.probes(), 2);
+  EXPECT_EQ(t.team(), 1);
+  EXPECT_EQ(t.switches(), 1);
+  EXPECT_LT(react + kProbe, 2 * TeamTuner::kHoldSteps);
+  // one step short of kSlowBlocks slow blocks: no probe yet
+  TeamTuner s(2);
+  start(s, 1.0, 0.8);
+  for (int k = 0; k < react - 1; ++k) s.step_done(s.team() == 1 ? 1.0 : 2.0);
+  EXPECT_EQ(s.probes(), 1);
+  EXPECT_EQ(s.team(), 2);
+  // three slow blocks of every four (list rebuilds, a busy moment): never kSlowBlocks in a row
+  TeamTuner u(2);
+  start(u, 1.0, 0.8);
+  for (int k = 0; k < 3000; ++k) u.step_done(u.team() == 1 ? 1.0 : ((k / TeamTuner::kBlockSteps) % 4 == 3 ? 0.8 : 2.0));
+  EXPECT_EQ(u.early_probes(), 0);
+  EXPECT_EQ(u.probes(), 1);
+  EXPECT_EQ(u.team(), 2);
+  // one thread held while it slows down (a taken core): not watched, no probe before the hold ends
+  TeamTuner w(2);
+  start(w, 1.0, 3.0);  // 2 threads on a taken core: 1 chosen
+  ASSERT_EQ(w.team(), 1);
+  for (int k = 0; k < 3000; ++k) w.step_done(w.team() == 1 ? 3.0 : 9.0);
+  EXPECT_EQ(w.early_probes(), 0);
+  EXPECT_EQ(w.probes(), 1);
 }
 
 // run_threads outside 0..threads is refused when the engine is made, naming the key.
