@@ -237,8 +237,7 @@ void Simulation::add_force(std::shared_ptr<BodyForce> f) {
 inline void Simulation::pack_disc(int i) {
   const int b = d_.body[i];
   const double w = b_.omega[b];
-  pdisc_[i] = {d_.x[i], d_.y[i], d_.r[i], b_.mass[b]};
-  pvel_[i] = {b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
+  pdisc_[i] = {d_.x[i], d_.y[i], d_.r[i], b_.mass[b], b_.vx[b] - w * d_.wy[i], b_.vy[b] + w * d_.wx[i], w, 0.0};
 }
 
 // World positions of the discs of body b from its pose.
@@ -477,7 +476,6 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
   const double L = params_.x_hi - params_.x_lo, hL = 0.5 * L;
   const double reach = pair_reach_;
   const PackedDisc* P = pdisc_.data();
-  const PackedVel* V = pvel_.data();
   const int* rs = nlist_.row_start_.data();
   const int* nb = nlist_.nbr_.data();
   double* eta = nlist_.eta_.data();
@@ -529,8 +527,8 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
       m += in ? 1 : 0;
     }
     if (interacts) {
-      const PackedVel& vi = V[i];
-      const PackedVel& vj = V[j];
+      const PackedDisc& vi = pi;
+      const PackedDisc& vj = pj;
       double et = eta[e], sd = static_cast<double>(sl[e]);
       double fx, fy, ti, tj, fax = 0.0, fay = 0.0, touching;
       detail::pair_contact<kAdhesion>(cp, hp, dt, d.x, d.y, pi.r, pj.r, pi.m, pj.m, vi.vx, vi.vy, vi.w, vj.vx, vj.vy,
@@ -562,7 +560,7 @@ template <bool kAdhesion, bool kPeriodic, int kList, bool kCross>
     auto ahead = [&](int k) __attribute__((always_inline)) {
       if (k + 8 < sn) {
         const SubEntry& q = sub[k + 8];
-        __builtin_prefetch(&P[q.j]); __builtin_prefetch(&V[q.j]); __builtin_prefetch(&f[q.j], 1);
+        __builtin_prefetch(&P[q.j]); __builtin_prefetch(&f[q.j], 1);
         __builtin_prefetch(&eta[q.e]);
       }
     };
@@ -750,7 +748,6 @@ void Simulation::contact_forces(double kick_h, bool packed, bool providers) {
   update_thread_split();
   if (!packed) {
     pdisc_.resize(n);
-    pvel_.resize(n);
   }
   // Every buffer the region writes is sized here: nothing allocates inside it (an exception must
   // not cross an OpenMP region), except the wall queries' scratch, whose failures are carried out.
@@ -1294,7 +1291,6 @@ void Simulation::step() {
   const bool check_list = check_moves && (list_check_ || !check_sub);
   const bool list_per_disc = check_list && nlist_.per_disc();
   pdisc_.resize(d_.x.size());
-  pvel_.resize(d_.x.size());
   if (!simple_valid_ || simple_prefix_.size() != nb + 1) update_simple();
   // Force providers that read no contact state run before the contact forces, whose pass over
   // the bodies adds their forces and kicks (BodyForce::reads_contacts): their arrays are
@@ -1331,12 +1327,11 @@ void Simulation::step() {
       // place_body and pack_disc, whose w * wy and w * wx are w * 0.0 here).
       const double* r = d_.r.data(); const double* mass = b_.mass.data();
       double* dx = d_.x.data(); double* dy = d_.y.data();
-      PackedDisc* pd = pdisc_.data(); PackedVel* pv = pvel_.data();
+      PackedDisc* pd = pdisc_.data();
       for (std::size_t b = c0, k = k0; b < c1; ++b, ++k) {
         const double X = x[b], Y = y[b], w = om[b];
         dx[k] = X; dy[k] = Y;
-        pd[k] = {X, Y, r[k], mass[b]};
-        pv[k] = {vx[b] - w * 0.0, vy[b] + w * 0.0, w, 0.0};
+        pd[k] = {X, Y, r[k], mass[b], vx[b] - w * 0.0, vy[b] + w * 0.0, w, 0.0};
       }
     } else {
       // place_body and pack_disc in one pass: the same values (pack_disc reads back what
@@ -1345,14 +1340,13 @@ void Simulation::step() {
       const double* mass = b_.mass.data(); const double* cth = b_.cth.data(); const double* sth = b_.sth.data();
       const int* first_disc = b_.first_disc.data(); const int* n_discs = b_.n_discs.data();
       double* dx = d_.x.data(); double* dy = d_.y.data(); double* dwx = d_.wx.data(); double* dwy = d_.wy.data();
-      PackedDisc* pd = pdisc_.data(); PackedVel* pv = pvel_.data();
+      PackedDisc* pd = pdisc_.data();
       for (std::size_t b = c0; b < c1; ++b) {
         const int first = first_disc[b], nd = n_discs[b];
         const double X = x[b], Y = y[b], w = om[b], m = mass[b], u = vx[b], v = vy[b];
         if (nd == 1 && ox[first] == 0.0 && oy[first] == 0.0) {
           dx[first] = X; dy[first] = Y; dwx[first] = 0.0; dwy[first] = 0.0;
-          pd[first] = {X, Y, r[first], m};
-          pv[first] = {u - w * 0.0, v + w * 0.0, w, 0.0};
+          pd[first] = {X, Y, r[first], m, u - w * 0.0, v + w * 0.0, w, 0.0};
           continue;
         }
         const double c = cth[b], sn = sth[b];
@@ -1362,8 +1356,7 @@ void Simulation::step() {
           const double px = X + wx, py = Y + wy;
           dwx[k] = wx; dwy[k] = wy;
           dx[k] = px; dy[k] = py;
-          pd[k] = {px, py, r[k], m};
-          pv[k] = {u - w * wy, v + w * wx, w, 0.0};
+          pd[k] = {px, py, r[k], m, u - w * wy, v + w * wx, w, 0.0};
         }
       }
     }

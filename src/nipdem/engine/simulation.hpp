@@ -237,7 +237,7 @@ class Simulation {
   void choose_skins();  // half_skin_ for the next list build (EngineParams::skin_speed_quantile)
   // kick_h > 0: also the closing half kick of velocity Verlet, body by body as its force is summed
   // (step() without force providers: one parallel region fewer per step); packed: step() has
-  // already made the pair kernel's copy of the discs (pdisc_, pvel_) from the present state
+  // already made the pair kernel's copy of the discs (pdisc_) from the present state
   // providers: call_providers() has run, and the body phase adds their forces before the kick
   // (step() when no provider reads_contacts(): the provider loop's region goes)
   void contact_forces(double kick_h = 0.0, bool packed = false, bool providers = false);
@@ -261,8 +261,9 @@ class Simulation {
   // Hot-loop copies of the per-disc data the pair kernel reads, packed so that one neighbour
   // costs two cache lines to read and one to write instead of ~12 scattered SoA loads
   // (docs/performance.md). Rebuilt from the SoA stores at every force evaluation.
-  struct alignas(32) PackedDisc { double x, y, r, m; };      // centre [m], radius [m], body mass [kg]
-  struct alignas(32) PackedVel { double vx, vy, w, pad; };   // disc-centre velocity [m/s], body spin [rad/s]
+  // centre [m], radius [m], body mass [kg], disc-centre velocity [m/s], body spin [rad/s]: one
+  // cache line, so a scattered partner costs one line, not two (docs/performance.md, 22nd pass)
+  struct alignas(64) PackedDisc { double x, y, r, m, vx, vy, w, pad; };
   struct alignas(32) PackedForce { double fx, fy, tq, pad; };
   // One entry of the per-step sublist: the Verlet list entry and its two discs.
   struct SubEntry { int e, i, j; };
@@ -293,7 +294,6 @@ class Simulation {
   std::vector<std::vector<double>> prov_fx_, prov_fy_, prov_tq_;
   std::vector<BodyForce::Held> held_;  // per provider, the held terms of its last add()
   std::vector<PackedDisc> pdisc_;
-  std::vector<PackedVel> pvel_;
   // Pair-force sums per disc, one buffer for all parts: a part writes only its own discs there.
   std::vector<PackedForce> pforce_;
   // contact_forces()' per-body phase: blocks of kBodyBlock bodies, shared out by stealing
