@@ -1,7 +1,10 @@
 // Electric screening (thesis §2.5.4): geometric tests with hand-placed discs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <vector>
 
 #include "nipdem/core/error.hpp"
@@ -96,4 +99,60 @@ TEST(ElectricScreening, RangeOnCircle) {
   EXPECT_FALSE(screening(far, drum, {}, params()).within_range);
   EXPECT_THROW(DrumSurface::circle({0, 0}, -1.0), InputError);
   EXPECT_THROW(DrumSurface::plane({0, 0}, {0, 0}), InputError);
+}
+
+// screening_reach bounds the centre distance of every disc that screens a particle in range
+// (ElectricForce tests only the discs within it along x). Random particles within range of a
+// circular drum (gap in [-r, range]), radii in [0.5, 1] r_max, corridor fractions up to 0.99,
+// and discs thrown around each within 1.3x the reach: every blocking one is within the reach,
+// and some reach beyond 0.6 of it (the bound is not loose by more than that: with range +
+// 2 r_max instead, discs of this test screen from beyond it).
+TEST(ElectricScreening, BlockingDiscsLieWithinTheReach) {
+  const double r_max = 6e-6;
+  const auto drum = DrumSurface::circle({0.0, 0.0}, Rd);
+  std::uint64_t s = 12345;
+  auto uni = [&s]() {  // xorshift64*, in [0, 1)
+    s ^= s >> 12; s ^= s << 25; s ^= s >> 27;
+    return static_cast<double>((s * 2685821657736338717ULL) >> 11) * 0x1.0p-53;
+  };
+  double farthest = 0.0;
+  int blocking = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    ScreeningParams p = params();
+    p.range_m = 10.5e-6 * (0.5 + 2.5 * uni());
+    p.corridor_fraction = 0.99 * uni();
+    const double rp = r_max * (0.5 + 0.5 * uni());
+    const double ang = 6.283185307179586 * uni();
+    const Vec2 dir{std::cos(ang), std::sin(ang)};
+    const Disc part{(Rd + rp + (-rp + (p.range_m + rp) * uni())) * dir, rp};
+    const double reach = screening_reach(p, r_max);
+    const auto res = screening(part, drum, {}, p);
+    ASSERT_TRUE(res.within_range);
+    for (int q = 0; q < 50; ++q) {
+      const double a = 6.283185307179586 * uni(), dist = 1.3 * reach * uni();
+      const Disc d{part.centre + Vec2{dist * std::cos(a), dist * std::sin(a)}, r_max * (0.5 + 0.5 * uni())};
+      if (!blocks_corridor(part, res.foot, d, p.corridor_fraction * rp)) continue;
+      ++blocking;
+      EXPECT_LT(dist, reach);
+      farthest = std::max(farthest, dist / reach);
+    }
+  }
+  EXPECT_GT(blocking, 1000);
+  EXPECT_GT(farthest, 0.6);
+  // The corner case: a particle of r_max at gap = range, corridor fraction 0.99, and a disc of
+  // r_max just over the corridor's far corner (0.7 r_max beyond its end and its side) screens
+  // it from sqrt((range + 1.7 r)^2 + (1.69 r)^2), beyond range + 2 r_max.
+  ScreeningParams p = params();
+  p.corridor_fraction = 0.99;
+  const Vec2 down{0.0, -1.0};  // from the particle to the drum (the drum above, kDrumC)
+  const auto top = DrumSurface::circle(kDrumC, Rd);
+  const Disc part{{0.0, -(p.range_m + r_max)}, r_max};
+  const auto res = screening(part, top, {}, p);
+  ASSERT_TRUE(res.within_range);
+  const double L = norm(res.foot - part.centre), w = 0.99 * r_max;
+  const Disc corner{part.centre - (L + 0.7 * r_max) * down + Vec2{w + 0.7 * r_max, 0.0}, r_max};
+  ASSERT_TRUE(blocks_corridor(part, res.foot, corner, w));
+  EXPECT_LT(norm(corner.centre - part.centre), screening_reach(p, r_max));
+  EXPECT_GT(norm(corner.centre - part.centre), p.range_m + 2.0 * r_max);
+  std::printf("blocking discs %d, farthest at %.3f of the reach\n", blocking, farthest);
 }

@@ -49,6 +49,12 @@ bool blocks_corridor(const Disc& particle, Vec2 foot, const Disc& d, double half
   return ds * ds + dt * dt < d.radius * d.radius;
 }
 
+double screening_reach(const ScreeningParams& p, double r_max_m) {
+  // |s| < L + r_d and |t| < w + r_d for a blocking disc (blocks_corridor), so its centre is
+  // within (L + r_d) + (w + r_d) <= range + r_max + r_max + 2 r_max
+  return p.range_m + 4.0 * r_max_m;
+}
+
 ScreeningResult screening(const Disc& particle, const DrumSurface& drum, std::span<const Disc> others,
                           const ScreeningParams& p, int self_index) {
   ScreeningResult r;

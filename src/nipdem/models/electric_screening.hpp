@@ -60,4 +60,10 @@ ScreeningResult screening(const Disc& particle, const DrumSurface& drum, std::sp
 // True if disc `d` intersects the corridor of `particle` towards `foot` (see above).
 bool blocks_corridor(const Disc& particle, Vec2 foot, const Disc& d, double half_width);
 
+// How far from a particle's centre a disc that screens it can be centred, when the particle is
+// within range and both radii are <= r_max_m: the corridor (length gap + r_p <= range + r_max,
+// half-width w < r_max) widened by the disc's radius on both sides, range + 4 r_max [m]. A
+// caller may leave out discs farther than this (ElectricForce: along x) and get the same flag.
+double screening_reach(const ScreeningParams& p, double r_max_m);
+
 }  // namespace nipdem::electric

@@ -13,7 +13,6 @@
 #include "nipdem/io/field_map.hpp"
 #include "nipdem/models/dipole.hpp"
 #include "nipdem/models/electric_screening.hpp"
-#include <set>
 
 namespace nipdem::nip {
 
@@ -318,17 +317,21 @@ void ElectricForce::refresh(const BodyStore& b, const DiscStore& d) {
   const auto& roller = walls[cfg_.roller_wall];
   // Contacts between bodies (from disc overlaps in the neighbour list) and with the roller.
   const auto& nl = sim_->neighbor_list();
-  std::set<std::pair<int, int>> pairs;
+  // (each body pair once, in ascending order: sorted and made unique)
+  auto& pairs = pair_scratch_;
+  pairs.clear();
   for (std::size_t i = 0; i + 1 < nl.row_start_.size() && i < d.x.size(); ++i) {
     for (int e = nl.row_start_[i]; e < nl.row_start_[i + 1]; ++e) {
       const int j = nl.nbr_[e];
       const double dx = d.x[i] - d.x[j], dy = d.y[i] - d.y[j], rs = d.r[i] + d.r[j];
       if (dx * dx + dy * dy < rs * rs) {
         const int a = d.body[i], c = d.body[j];
-        pairs.insert({std::min(a, c), std::max(a, c)});
+        pairs.push_back({std::min(a, c), std::max(a, c)});
       }
     }
   }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   std::vector<conduction::Contact> contacts;
   contacts.reserve(pairs.size());
   for (auto& [a, c] : pairs) contacts.push_back({a, c, cfg_.rc.R_tt_ohm});
@@ -351,19 +354,32 @@ void ElectricForce::refresh(const BodyStore& b, const DiscStore& d) {
   r_path_.assign(nb, charge::kNoPath);
   for (std::size_t i = 0; i < nb; ++i) r_path_[i] = paths_.path_resistance(static_cast<int>(i));
   // Who feels the force: within range of the drum and not screened (§2.5.4).
-  std::vector<electric::Disc> layer;
-  std::vector<int> layer_disc;
+  // The layer's discs in order of x: a body's candidates for screening are those within
+  // `window` of it along x (see below), found by bisection instead of a pass over the layer.
+  std::vector<int>& layer = layer_scratch_;
+  layer.clear();
   const double reach = cfg_.rc.range_m + 2.0 * cfg_.rc.range_m;
+  double r_max = 0.0;
   for (std::size_t k = 0; k < d.x.size(); ++k) {
     if (norm(Vec2{d.x[k], d.y[k]} - drum.centre) - drum.radius - d.r[k] < reach) {
-      layer.push_back({{d.x[k], d.y[k]}, d.r[k]});
-      layer_disc.push_back(static_cast<int>(k));
+      layer.push_back(static_cast<int>(k));
+      r_max = std::max(r_max, d.r[k]);
     }
   }
-  const auto surface = electric::DrumSurface::circle(drum.centre, drum.radius);
+  std::sort(layer.begin(), layer.end(), [&](int a, int c) { return d.x[a] < d.x[c] || (d.x[a] == d.x[c] && a < c); });
+  std::vector<double>& layer_x = layer_x_scratch_;
+  layer_x.resize(layer.size());
+  for (std::size_t q = 0; q < layer.size(); ++q) layer_x[q] = d.x[layer[q]];
+  // A disc that blocks a body's corridor is centred within screening_reach of the body's disc
+  // (every disc tested is of the layer, radius <= r_max): one farther along x cannot block (the
+  // window is that bound with 1e-6 to spare, so rounding never leaves a blocking disc out).
+  // Only whether some disc blocks is used, not which: the screened flags are those of testing
+  // every disc of the layer.
   electric::ScreeningParams sp;
   sp.range_m = cfg_.rc.range_m;
   sp.corridor_fraction = cfg_.corridor_fraction;
+  const double window = electric::screening_reach(sp, r_max) * (1.0 + 1e-6);
+  const auto surface = electric::DrumSurface::circle(drum.centre, drum.radius);
   coupling_.assign(nb, charge::DrumCoupling::none);
   printable_.assign(nb, 0);
   n_printable_ = 0;
@@ -374,8 +390,13 @@ void ElectricForce::refresh(const BodyStore& b, const DiscStore& d) {
     // screening by discs of other bodies only (a particle's own members never screen it)
     bool screened = false;
     const electric::Disc self{{d.x[k], d.y[k]}, d.r[k]};
-    std::vector<electric::Disc> others;
-    for (std::size_t q = 0; q < layer.size(); ++q) if (d.body[layer_disc[q]] != static_cast<int>(i)) others.push_back(layer[q]);
+    std::vector<electric::Disc>& others = others_scratch_;
+    others.clear();
+    const auto lo = std::lower_bound(layer_x.begin(), layer_x.end(), d.x[k] - window);
+    for (auto q = static_cast<std::size_t>(lo - layer_x.begin()); q < layer.size() && layer_x[q] <= d.x[k] + window; ++q) {
+      const int c = layer[q];
+      if (d.body[c] != static_cast<int>(i)) others.push_back({{d.x[c], d.y[c]}, d.r[c]});
+    }
     const auto res = electric::screening(self, surface, others, sp);
     screened = res.screened;
     if (!screened) { printable_[i] = 1; ++n_printable_; }

@@ -4,11 +4,13 @@
 #pragma once
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "nipdem/engine/simulation.hpp"
 #include "nipdem/io/print_pattern.hpp"
 #include "nipdem/models/electric_force.hpp"
+#include "nipdem/models/electric_screening.hpp"
 #include "nipdem/models/rc_charge.hpp"
 #include "nipdem/solvers/conduction_path.hpp"
 #include "nipdem/models/dipole.hpp"
@@ -150,6 +152,11 @@ class ElectricForce final : public engine::BodyForce {
   std::vector<int> near_disc_;              // disc of each body nearest the drum
   std::vector<double> gap_;                 // its surface gap to the drum [m]
   std::vector<double> r_path_;              // path resistance at the last refresh [ohm]
+  // refresh()'s scratch (kept between calls: no allocation per refresh)
+  std::vector<std::pair<int, int>> pair_scratch_;
+  std::vector<int> layer_scratch_;
+  std::vector<double> layer_x_scratch_;
+  std::vector<electric::Disc> others_scratch_;
   double v_drum_ = 0.0, t_last_ = -1.0;
   long calls_ = 0;
   int n_printable_ = 0;
