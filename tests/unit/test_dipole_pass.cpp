@@ -4,6 +4,7 @@
 // and must not depend on when the list was built (checkpoint/resume stays bitwise).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -215,5 +216,30 @@ TEST(DipolePass, TheListIsTheSameBuiltOnAnyNumberOfThreads) {
     EXPECT_EQ(ps.listed_pairs(), one.listed_pairs());
     EXPECT_EQ(fx, fx1) << "built on " << run << " threads";
     EXPECT_EQ(fy, fy1) << "built on " << run << " threads";
+  }
+}
+
+// The list build's row order (dipole::sort_row): ascending, as std::sort gives it, for rows
+// whose partners all lie within +-2048 of the row (the bit set, including both edges of that
+// span) and rows with one beyond (sorted), empty and one-partner rows; the bit set is left clear.
+TEST(DipolePass, RowsAreSortedWhereverTheirPartnersLie) {
+  Rng r(99);
+  dipole::RowSortBits bits{};
+  for (int trial = 0; trial < 3000; ++trial) {
+    const int row = static_cast<int>(r.uniform(3000.0, 20000.0));  // (room for partners 2100 below)
+    const int m = trial % 7 == 0 ? trial % 2 : static_cast<int>(r.uniform(2.0, 90.0));
+    const double spread = trial % 3 == 0 ? 2100.0 : (trial % 3 == 1 ? 2048.0 : 300.0);
+    std::vector<int> c;
+    while (static_cast<int>(c.size()) < m) {
+      int j = row + static_cast<int>(std::floor(r.uniform(-spread, spread)));
+      if (trial % 5 == 0) j = c.size() % 2 ? row - 2048 + static_cast<int>(c.size()) : row + 2047 - static_cast<int>(c.size());
+      if (j < 0 || j == row || std::find(c.begin(), c.end(), j) != c.end()) continue;
+      c.push_back(j);
+    }
+    std::vector<int> want = c;
+    std::sort(want.begin(), want.end());
+    dipole::sort_row(c.data(), m, row, bits);
+    ASSERT_EQ(c, want) << "trial " << trial;
+    for (auto w : bits) ASSERT_EQ(w, 0u) << "trial " << trial;
   }
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <tuple>
 #include <fmt/format.h>
 #include <omp.h>
 
@@ -150,6 +151,33 @@ bool PairSum::moved(std::span<const double> x, std::span<const double> y) const 
   return std::sqrt(d1) + std::sqrt(d2) > 0.98 * p_.skin_m;
 }
 
+void sort_row(int* c, int m, int row, RowSortBits& bits) {
+  constexpr int kSpan = 64 * static_cast<int>(std::tuple_size_v<RowSortBits>);
+  const int base = row - kSpan / 2;
+  bool near = true;
+  for (int k = 0; k < m; ++k) near &= static_cast<unsigned>(c[k] - base) < static_cast<unsigned>(kSpan);
+  if (!near) {
+    std::sort(c, c + m);
+    return;
+  }
+  int w_lo = kSpan / 64, w_hi = -1;
+  for (int k = 0; k < m; ++k) {
+    const int o = c[k] - base;
+    bits[static_cast<std::size_t>(o >> 6)] |= std::uint64_t{1} << (o & 63);
+    w_lo = std::min(w_lo, o >> 6);
+    w_hi = std::max(w_hi, o >> 6);
+  }
+  int out = 0;
+  for (int w = w_lo; w <= w_hi; ++w) {
+    std::uint64_t v = bits[static_cast<std::size_t>(w)];
+    bits[static_cast<std::size_t>(w)] = 0;
+    while (v != 0) {
+      c[out++] = base + 64 * w + __builtin_ctzll(v);
+      v &= v - 1;
+    }
+  }
+}
+
 void PairSum::rebuild(std::span<const double> x, std::span<const double> y, int run) {
   const std::size_t n = x.size();
   const double reach = p_.cutoff_m + p_.skin_m, reach2 = reach * reach;
@@ -229,7 +257,7 @@ void PairSum::rebuild(std::span<const double> x, std::span<const double> y, int 
               m += static_cast<int>((j != ii) & (owner == ii) & (dx * dx + dy * dy < reach2));
             }
           }
-          std::sort(P.cand.begin(), P.cand.begin() + m);
+          sort_row(P.cand.data(), m, ii, P.bits);
           P.nbr.insert(P.nbr.end(), P.cand.begin(), P.cand.begin() + m);
           row_start_[i + 1] = m;
           P.max_row = std::max(P.max_row, m);
