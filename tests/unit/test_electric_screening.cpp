@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <vector>
 
 #include "nipdem/core/error.hpp"
@@ -154,5 +153,4 @@ TEST(ElectricScreening, BlockingDiscsLieWithinTheReach) {
   ASSERT_TRUE(blocks_corridor(part, res.foot, corner, w));
   EXPECT_LT(norm(corner.centre - part.centre), screening_reach(p, r_max));
   EXPECT_GT(norm(corner.centre - part.centre), p.range_m + 2.0 * r_max);
-  std::printf("blocking discs %d, farthest at %.3f of the reach\n", blocking, farthest);
 }

@@ -1,6 +1,7 @@
 #include "nipdem/models/dipole.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -172,7 +173,7 @@ void sort_row(int* c, int m, int row, RowSortBits& bits) {
     std::uint64_t v = bits[static_cast<std::size_t>(w)];
     bits[static_cast<std::size_t>(w)] = 0;
     while (v != 0) {
-      c[out++] = base + 64 * w + __builtin_ctzll(v);
+      c[out++] = base + 64 * w + std::countr_zero(v);
       v &= v - 1;
     }
   }
